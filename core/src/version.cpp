@@ -1,0 +1,5 @@
+#include "conform/version.hpp"
+
+namespace conform {
+const char* version() { return CONFORM_VERSION; }
+}  // namespace conform

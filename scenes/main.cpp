@@ -1,0 +1,23 @@
+// The `conform` command: headless scenes and tools built on the Conform library.
+#include <iostream>
+
+#include "commands.hpp"
+#include "conform/version.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"conform — CGA skinning, cutting and IK for Bullet soft bodies"};
+  app.set_version_flag("--version", std::string("conform ") + conform::version());
+  conform::cli::Context context;
+  conform::cli::register_info(app, context);
+  app.require_subcommand(0, 1);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  if (app.get_subcommands().empty()) {
+    std::cout << "conform " << conform::version() << "\n" << app.help() << std::flush;
+    return 0;
+  }
+  return context.exit_code;
+}
