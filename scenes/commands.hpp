@@ -1,5 +1,6 @@
 // Subcommands of the `conform` command; each lives in its own cmd_*.cpp and registers itself
-// with the CLI11 app. A subcommand returns the process exit code through `exit_code`.
+// with the CLI11 app. A subcommand returns the process exit code through `context.exit_code`
+// (errors go to stderr with a non-zero code, never an uncaught exception).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -10,6 +11,9 @@ struct Context {
   int exit_code = 0;
 };
 
-void register_info(CLI::App& app, Context& context);
+void register_info(CLI::App& app, Context& context);   // cmd_info.cpp   (issue 3 extends)
+void register_ik(CLI::App& app, Context& context);     // cmd_ik.cpp     (issue 4)
+void register_skin(CLI::App& app, Context& context);   // cmd_skin.cpp   (issue 3)
+void register_mesh_ops(CLI::App& app, Context& context);  // cmd_mesh_ops.cpp (issue 5)
 
 }  // namespace conform::cli

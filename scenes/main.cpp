@@ -9,6 +9,9 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("conform ") + conform::version());
   conform::cli::Context context;
   conform::cli::register_info(app, context);
+  conform::cli::register_ik(app, context);
+  conform::cli::register_skin(app, context);
+  conform::cli::register_mesh_ops(app, context);
   app.require_subcommand(0, 1);
   try {
     app.parse(argc, argv);

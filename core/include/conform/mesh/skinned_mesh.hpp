@@ -1,0 +1,40 @@
+// The skinned triangle mesh shared by import, skinning, topology operations and the plugin.
+//
+// Shapes (libigl style, #V vertices, #F faces):
+//   rest       3 × #V  bind-pose positions, in the model space the skeleton's bind versors use
+//   current    3 × #V  current positions (posed by skinning, or simulated); what cut/tear/drill
+//                      operate on
+//   faces      #F      counter-clockwise (outward normal by the right-hand rule) triangles
+//   bones      4 × #V  bone indices of the up to 4 largest influences, unused slots 0
+//   weights    4 × #V  their weights, sorted decreasing, summing to 1, unused slots 0
+//   uvs        2 × #V  or empty
+//   normals    3 × #V  rest-space normals, or empty
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace conform::mesh {
+
+inline constexpr int kMaxInfluences = 4;
+
+using Face = std::array<std::int32_t, 3>;
+
+struct SkinnedMesh {
+  Eigen::Matrix3Xd rest;
+  Eigen::Matrix3Xd current;
+  std::vector<Face> faces;
+  Eigen::Matrix<std::int32_t, kMaxInfluences, Eigen::Dynamic> bones;
+  Eigen::Matrix<double, kMaxInfluences, Eigen::Dynamic> weights;
+  Eigen::Matrix2Xd uvs;
+  Eigen::Matrix3Xd normals;
+
+  std::int32_t vertex_count() const { return static_cast<std::int32_t>(rest.cols()); }
+  std::int32_t face_count() const { return static_cast<std::int32_t>(faces.size()); }
+  bool has_uvs() const { return uvs.cols() == rest.cols() && uvs.cols() > 0; }
+  bool has_normals() const { return normals.cols() == rest.cols() && normals.cols() > 0; }
+};
+
+}  // namespace conform::mesh

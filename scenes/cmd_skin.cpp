@@ -1,0 +1,8 @@
+#include "commands.hpp"
+
+namespace conform::cli {
+
+// Placeholder registration: the subcommand is added by its issue's work.
+void register_skin(CLI::App&, Context&) {}
+
+}  // namespace conform::cli
