@@ -1,0 +1,38 @@
+// Export of a SkinnedMesh's positions as PLY (binary little-endian or ASCII) or OBJ.
+//
+// Files are written atomically: the data go to a temporary file in the same directory, which
+// is renamed over the target only once it is complete, so a reader never sees half a mesh.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string_view>
+
+#include "conform/mesh/skinned_mesh.hpp"
+
+namespace conform::io {
+
+enum class MeshFormat { PlyBinary, PlyAscii, Obj };
+
+struct MeshExportOptions {
+  MeshFormat format = MeshFormat::PlyBinary;
+  /// Write the rest (bind-pose) positions instead of the current ones.
+  bool rest_positions = false;
+  /// Write UVs when the mesh has them (PLY: s, t properties; OBJ: vt lines).
+  bool uvs = true;
+};
+
+/// "ply" (binary), "ply-ascii" or "obj"; throws std::invalid_argument otherwise.
+MeshFormat parse_mesh_format(std::string_view name);
+/// ".ply" or ".obj".
+const char* mesh_format_extension(MeshFormat format);
+
+/// Writes `mesh` to `path`. When `faces` is not empty only those faces (indices into
+/// mesh.faces) are written, with the vertices they use renumbered in increasing order; this is
+/// how one piece of a cut mesh is exported. Throws std::runtime_error on I/O failure (the
+/// target is then left untouched) and std::out_of_range on an invalid face or vertex index.
+void write_mesh(const std::filesystem::path& path, const mesh::SkinnedMesh& mesh,
+                const MeshExportOptions& options = {}, std::span<const std::int32_t> faces = {});
+
+}  // namespace conform::io
