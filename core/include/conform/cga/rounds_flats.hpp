@@ -40,10 +40,11 @@ struct Line {
   }
   /// Unit direction (sign fixed by the outer form X1∧X2∧e∞: from X1 to X2).
   Vec3<T> direction() const {
-    // Outer form L = X1∧X2∧e∞ has e_i∧e0-free part; its direction is −(e0⌋L)⌋e∞ terms.
+    // For L = X1∧X2∧e∞ = (x2 − x1)∧e∞∧... the contraction (e∞∧e0)⌋L is −(x2 − x1) plus
+    // nothing else, so the direction is its negated Euclidean part.
     const Multivector<T> outer = mv.undual();
     const Multivector<T> d = (e0<T>() ^ einf<T>()) << outer;
-    Vec3<T> v(d[kE1], d[kE2], d[kE3]);
+    Vec3<T> v(-d[kE1], -d[kE2], -d[kE3]);
     return v.normalized();
   }
 };
