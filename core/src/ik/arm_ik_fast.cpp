@@ -1,0 +1,211 @@
+// The closed-form solvers: one target (solve) and structure-of-arrays batches (BatchSolveJob).
+// The arithmetic is detail::solve_kernel (kernel.hpp, formulas beside it); this file only
+// feeds it, vectorizes the batch loop and splits it across OpenMP threads.
+
+// sqrt must not set errno here: the errno path is a library call per element, which stops
+// the loop from vectorizing. Every sqrt argument in the kernel is ≥ 0 by construction.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC optimize("no-math-errno")
+#endif
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cstddef>
+
+#include "conform/ik/arm_ik.hpp"
+#include "conform/ik/kernel.hpp"
+#include "conform/ik/limits.hpp"
+
+namespace conform::ik {
+
+std::string to_string(Status s) {
+  if (s == Status::kOk) return "ok";
+  static constexpr std::pair<Status, const char*> kNames[] = {
+      {Status::kClampedOuter, "clamped_outer"},
+      {Status::kClampedInner, "clamped_inner"},
+      {Status::kTargetAtShoulder, "target_at_shoulder"},
+      {Status::kTargetOnZAxis, "target_on_z_axis"},
+      {Status::kElbowOnZAxis, "elbow_on_z_axis"},
+      {Status::kElbowLimit, "elbow_limit"},
+      {Status::kShoulderLimit, "shoulder_limit"},
+      {Status::kInvalidInput, "invalid_input"}};
+  std::string out;
+  for (const auto& [flag, name] : kNames) {
+    if (!has(s, flag)) continue;
+    if (!out.empty()) out += '|';
+    out += name;
+  }
+  return out;
+}
+
+template <class T>
+bool Arm<T>::valid() const {
+  const auto finite_pos = [](T v) { return std::isfinite(v) && v > T(0); };
+  const JointLimits<T>& l = limits;
+  return finite_pos(upper) && finite_pos(fore) && std::isfinite(l.elbow_min) &&
+         std::isfinite(l.elbow_max) && l.elbow_min >= T(0) && l.elbow_min <= l.elbow_max &&
+         l.elbow_max <= std::numbers::pi_v<T> && l.cone_half_angle > T(0) &&
+         l.cone_axis.allFinite() && (!l.has_cone() || l.cone_axis.norm() > T(0));
+}
+template struct Arm<float>;
+template struct Arm<double>;
+
+namespace {
+
+template <class T>
+detail::KernelConstants<T> constants(const Arm<T>& arm) {
+  return detail::KernelConstants<T>::make(arm.upper, arm.fore, arm.limits.elbow_min,
+                                          arm.limits.elbow_max);
+}
+
+template <class T>
+Solution<T> to_solution(const detail::KernelResult<T>& r) {
+  Solution<T> s;
+  s.qs = Quat<T>(r.qs_w, r.qs_x, r.qs_y, r.qs_z);
+  s.qe = Quat<T>(r.qe_w, r.qe_x, T(0), T(0));
+  s.elbow = Vec3<T>(r.ex, r.ey, r.ez);
+  s.status = static_cast<Status>(r.status);
+  return s;
+}
+
+}  // namespace
+
+template <class T>
+Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, T swivel) {
+  if (!arm.valid()) {
+    Solution<T> s;
+    s.status = Status::kInvalidInput;
+    return s;
+  }
+  const auto c = constants(arm);
+  const auto run = [&](T phi) {
+    return detail::solve_kernel(c, target.x(), target.y(), target.z(), phi);
+  };
+  if (!arm.limits.has_cone()) return to_solution(run(swivel));
+
+  Status extra = Status::kOk;
+  bool rotate_after = false;
+  const detail::KernelResult<T> probe = run(swivel);
+  if (probe.status & detail::kBitInvalid) return to_solution(probe);
+  const T phi = detail::cone_swivel(
+      arm, swivel,
+      [&](T p) {
+        const auto r = run(p);
+        return Vec3<T>(r.ex, r.ey, r.ez);
+      },
+      extra, rotate_after);
+  Solution<T> s = to_solution(run(phi));
+  s.status |= extra;
+  if (rotate_after) detail::cone_rotate(arm, s);
+  return s;
+}
+
+template Solution<float> solve(const Arm<float>&, const Vec3<float>&, float);
+template Solution<double> solve(const Arm<double>&, const Vec3<double>&, double);
+
+// ----- batch -----
+
+namespace {
+
+template <class T>
+struct BatchPointers {
+  const T *x, *y, *z, *phi;
+  T *qw, *qx, *qy, *qz, *ew, *ex, *px, *py, *pz;
+  std::uint8_t* st;
+};
+
+template <class T>
+[[gnu::always_inline]] inline void run_range_body(const detail::KernelConstants<T>& constants,
+                                                  const BatchPointers<T>& p, std::ptrdiff_t begin,
+                                                  std::ptrdiff_t end) {
+  const T* __restrict x = p.x;
+  const T* __restrict y = p.y;
+  const T* __restrict z = p.z;
+  const T* __restrict phi = p.phi;
+  T* __restrict qw = p.qw;
+  T* __restrict qx = p.qx;
+  T* __restrict qy = p.qy;
+  T* __restrict qz = p.qz;
+  T* __restrict ew = p.ew;
+  T* __restrict ex = p.ex;
+  T* __restrict px = p.px;
+  T* __restrict py = p.py;
+  T* __restrict pz = p.pz;
+  std::uint8_t* __restrict st = p.st;
+  const detail::KernelConstants<T> c = constants;  // a local copy: its loads cannot alias
+#pragma omp simd
+  for (std::ptrdiff_t i = begin; i < end; ++i) {
+    const detail::KernelResult<T> r = detail::solve_kernel(c, x[i], y[i], z[i], phi[i]);
+    qw[i] = r.qs_w, qx[i] = r.qs_x, qy[i] = r.qs_y, qz[i] = r.qs_z;
+    ew[i] = r.qe_w, ex[i] = r.qe_x;
+    px[i] = r.ex, py[i] = r.ey, pz[i] = r.ez;
+    st[i] = r.status;
+  }
+}
+
+// One clone per instruction set, picked at load time (the default build targets baseline
+// x86-64, whose SSE2 is 4 floats wide; AVX-512 machines get 16).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(CONFORM_NO_CLONES)
+#define CONFORM_IK_CLONES \
+  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#else
+#define CONFORM_IK_CLONES
+#endif
+
+CONFORM_IK_CLONES void run_range(const detail::KernelConstants<float>& c,
+                                 const BatchPointers<float>& p, std::ptrdiff_t begin,
+                                 std::ptrdiff_t end) {
+  run_range_body(c, p, begin, end);
+}
+CONFORM_IK_CLONES void run_range(const detail::KernelConstants<double>& c,
+                                 const BatchPointers<double>& p, std::ptrdiff_t begin,
+                                 std::ptrdiff_t end) {
+  run_range_body(c, p, begin, end);
+}
+
+}  // namespace
+
+template <class T>
+bool BatchSolveJob<T>::Validate() const {
+  if (!arm.valid() || arm.limits.has_cone()) return false;
+  const std::size_t n = x.size();
+  for (std::size_t s :
+       {y.size(), z.size(), swivel.size(), qs_w.size(), qs_x.size(), qs_y.size(), qs_z.size(),
+        qe_w.size(), qe_x.size(), elbow_x.size(), elbow_y.size(), elbow_z.size(), status.size()})
+    if (s != n) return false;
+  return threads >= 0;
+}
+
+template <class T>
+bool BatchSolveJob<T>::Run() const {
+  if (!Validate()) return false;
+  const auto c = constants(arm);
+  const BatchPointers<T> p{x.data(),       y.data(),     z.data(),       swivel.data(),
+                           qs_w.data(),    qs_x.data(),  qs_y.data(),    qs_z.data(),
+                           qe_w.data(),    qe_x.data(),  elbow_x.data(), elbow_y.data(),
+                           elbow_z.data(), status.data()};
+  const auto n = static_cast<std::ptrdiff_t>(x.size());
+  const int wanted = threads > 0 ? threads : omp_get_max_threads();
+  // Below a few thousand solves a thread costs more to wake than it saves.
+  constexpr std::ptrdiff_t kMinPerThread = 2048;
+  const int team = static_cast<int>(std::clamp<std::ptrdiff_t>(n / kMinPerThread, 1, wanted));
+  if (team <= 1) {
+    run_range(c, p, 0, n);
+    return true;
+  }
+#pragma omp parallel num_threads(team)
+  {
+    const std::ptrdiff_t nt = omp_get_num_threads(), t = omp_get_thread_num();
+    // Contiguous chunks, multiples of 64 elements so that threads never share a cache line.
+    const std::ptrdiff_t chunk = ((n + nt - 1) / nt + 63) / 64 * 64;
+    const std::ptrdiff_t begin = std::min(n, t * chunk), end = std::min(n, begin + chunk);
+    if (begin < end) run_range(c, p, begin, end);
+  }
+  return true;
+}
+
+template struct BatchSolveJob<float>;
+template struct BatchSolveJob<double>;
+
+}  // namespace conform::ik
