@@ -1,0 +1,73 @@
+// Planar cut (Algorithm 1 of the second paper), on the current positions.
+//
+//   1. classify every vertex once by X·Π (conformal point against the plane Π = n + d e∞);
+//      vertices within plane_tolerance × (bounding diagonal) are on the plane;
+//   2. snap: where Π crosses an edge closer than snap_fraction of its length to an end, that
+//      end is taken as on the plane instead (no needle triangles); vertices are never moved;
+//   3. one new vertex per crossed edge (edge parameter t from the lower vertex index), shared
+//      by the faces on both sides; split triangles stay triangles (a quad is split along its
+//      shorter diagonal);
+//   4. separate the sides: the positive side keeps the original vertices, every fan of faces
+//      around a loop vertex beyond the first gets a duplicate (normally: the negative side);
+//      faces lying in the plane go to the side opposite their normal;
+//   5. optionally cap every closed cut loop with an ear-clipped triangulation, both sides.
+// Pieces are then the connected components (label_pieces), so one plane may give many.
+//
+// Degenerate input: a non-finite or zero-normal plane, or non-finite positions, throw
+// std::invalid_argument; a plane that misses or only touches the mesh returns status Missed
+// with an empty change (a documented no-op).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "conform/cga/plane.hpp"
+#include "conform/mesh/analysis.hpp"
+#include "conform/mesh/topology_change.hpp"
+
+namespace conform::mesh {
+
+/// Which predicates classify vertices and intersect edges: the conformal inner product
+/// X·Π with X = up(x), or the plain Euclidean n·x − d (kept for the paper's Table 1).
+enum class Predicates { Cga, Euclidean };
+
+struct CutOptions {
+  double plane_tolerance = 1e-9;  // × bounding diagonal
+  double snap_fraction = 0.01;    // of an edge's length
+  bool cap = false;
+  Predicates predicates = Predicates::Cga;
+};
+
+enum class CutStatus { Cut, Missed };
+
+struct CutResult {
+  CutStatus status = CutStatus::Missed;
+  TopologyChange change;
+  std::vector<std::int8_t> added_side;  // +1 / −1 for each added face (caps included)
+  std::int32_t crossed_edges = 0;
+  std::int32_t snapped_vertices = 0;  // vertices taken as on the plane by step 2
+  std::int32_t loops = 0;             // closed cut loops found (when capping)
+  std::int32_t capped_loops = 0;
+  std::int32_t cap_faces = 0;  // per side
+  std::string message;         // why a loop was not capped, when one was not
+};
+
+/// Step 1 alone (exposed for benchmarks): signed distances of the current positions.
+void classify_vertices(const SkinnedMesh& mesh, const cga::Plane<double>& plane,
+                       Predicates predicates, std::vector<double>& distance);
+
+/// Computes the change without touching the mesh.
+CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane,
+                      const CutOptions& options = {});
+
+struct CutOutcome {
+  CutResult result;
+  Pieces pieces;
+};
+
+/// compute_cut, apply (keeping `adjacency` up to date), then label the pieces.
+CutOutcome cut(SkinnedMesh& mesh, Adjacency& adjacency, const cga::Plane<double>& plane,
+               const CutOptions& options = {});
+
+}  // namespace conform::mesh

@@ -1,0 +1,165 @@
+#include "conform/mesh/analysis.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <tuple>
+
+namespace conform::mesh {
+
+namespace {
+
+template <class Fn>
+void for_faces(const SkinnedMesh& mesh, std::span<const std::int32_t> faces, Fn fn) {
+  if (faces.empty()) {
+    for (const Face& f : mesh.faces) fn(f);
+  } else {
+    for (auto i : faces) fn(mesh.faces[static_cast<std::size_t>(i)]);
+  }
+}
+
+std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t x) {
+  while (parent[static_cast<std::size_t>(x)] != x) {
+    parent[static_cast<std::size_t>(x)] =
+        parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+    x = parent[static_cast<std::size_t>(x)];
+  }
+  return x;
+}
+
+}  // namespace
+
+double surface_area(const SkinnedMesh& mesh, std::span<const std::int32_t> faces) {
+  double a = 0;
+  for_faces(mesh, faces, [&](const Face& f) {
+    const Eigen::Vector3d p = mesh.current.col(f[0]);
+    a += 0.5 * (mesh.current.col(f[1]) - p).cross(mesh.current.col(f[2]) - p).norm();
+  });
+  return a;
+}
+
+double signed_volume(const SkinnedMesh& mesh, std::span<const std::int32_t> faces) {
+  double v = 0;
+  for_faces(mesh, faces, [&](const Face& f) {
+    const Eigen::Vector3d a = mesh.current.col(f[0]), b = mesh.current.col(f[1]),
+                          c = mesh.current.col(f[2]);
+    v += a.dot(b.cross(c));
+  });
+  return v / 6;
+}
+
+double bounding_diagonal(const SkinnedMesh& mesh) {
+  if (mesh.current.cols() == 0) return 0;
+  return (mesh.current.rowwise().maxCoeff() - mesh.current.rowwise().minCoeff()).norm();
+}
+
+std::string MeshReport::summary() const {
+  return std::string(indices_valid ? "" : "invalid indices; ") +
+         (finite ? "" : "non-finite positions; ") + "tiny faces " + std::to_string(tiny_faces) +
+         ", boundary edges " + std::to_string(boundary_edges) + ", overused edges " +
+         std::to_string(overused_edges) + ", misoriented edges " +
+         std::to_string(misoriented_edges) + ", non-manifold vertices " +
+         std::to_string(nonmanifold_vertices);
+}
+
+MeshReport check_mesh(const SkinnedMesh& mesh, double min_area) {
+  MeshReport r;
+  const std::int32_t nv = mesh.vertex_count();
+  r.finite = mesh.current.allFinite();
+  for (const Face& f : mesh.faces)
+    for (auto v : f)
+      if (v < 0 || v >= nv) r.indices_valid = false;
+  for (const Face& f : mesh.faces)
+    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) r.indices_valid = false;
+  if (!r.indices_valid) return r;
+  for (const Face& f : mesh.faces) {
+    const Eigen::Vector3d p = mesh.current.col(f[0]);
+    const double a = 0.5 * (mesh.current.col(f[1]) - p).cross(mesh.current.col(f[2]) - p).norm();
+    if (!(a > min_area)) ++r.tiny_faces;
+  }
+  // Undirected edges with their direction counts.
+  std::vector<std::tuple<std::int32_t, std::int32_t, int>> e;  // (min, max, +1 if min→max)
+  e.reserve(mesh.faces.size() * 3);
+  for (const Face& f : mesh.faces)
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t u = f[k], v = f[(k + 1) % 3];
+      e.emplace_back(std::min(u, v), std::max(u, v), u < v ? 1 : 0);
+    }
+  std::sort(e.begin(), e.end());
+  for (std::size_t i = 0; i < e.size();) {
+    std::size_t j = i;
+    int forward = 0;
+    while (j < e.size() && std::get<0>(e[j]) == std::get<0>(e[i]) &&
+           std::get<1>(e[j]) == std::get<1>(e[i]))
+      forward += std::get<2>(e[j]), ++j;
+    const auto n = static_cast<int>(j - i);
+    if (n == 1) ++r.boundary_edges;
+    if (n > 2) ++r.overused_edges;
+    if (n == 2 && forward != 1) ++r.misoriented_edges;
+    i = j;
+  }
+  // Vertex fans: faces around a vertex joined through shared edges must form one group.
+  std::vector<std::int32_t> start(static_cast<std::size_t>(nv) + 1, 0);
+  for (const Face& f : mesh.faces)
+    for (auto v : f) ++start[static_cast<std::size_t>(v) + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::int32_t> inc(static_cast<std::size_t>(start.back()));
+  std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
+  for (std::size_t fi = 0; fi < mesh.faces.size(); ++fi)
+    for (auto v : mesh.faces[fi])
+      inc[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] =
+          static_cast<std::int32_t>(fi);
+  std::vector<std::int32_t> parent;
+  for (std::int32_t v = 0; v < nv; ++v) {
+    const auto b = static_cast<std::size_t>(start[static_cast<std::size_t>(v)]);
+    const auto n = static_cast<std::int32_t>(start[static_cast<std::size_t>(v) + 1] -
+                                             start[static_cast<std::size_t>(v)]);
+    if (n <= 1) continue;
+    parent.resize(static_cast<std::size_t>(n));
+    std::iota(parent.begin(), parent.end(), 0);
+    for (std::int32_t i = 0; i < n; ++i)
+      for (std::int32_t j = i + 1; j < n; ++j) {
+        const Face& a = mesh.faces[static_cast<std::size_t>(inc[b + static_cast<std::size_t>(i)])];
+        const Face& c = mesh.faces[static_cast<std::size_t>(inc[b + static_cast<std::size_t>(j)])];
+        // Share an edge through v: a common vertex other than v.
+        bool shared = false;
+        for (auto x : a)
+          if (x != v && (x == c[0] || x == c[1] || x == c[2])) shared = true;
+        if (shared) parent[static_cast<std::size_t>(find_root(parent, i))] = find_root(parent, j);
+      }
+    int groups = 0;
+    for (std::int32_t i = 0; i < n; ++i) groups += find_root(parent, i) == i;
+    if (groups > 1) ++r.nonmanifold_vertices;
+  }
+  return r;
+}
+
+std::vector<std::int32_t> Pieces::faces_of(std::int32_t p) const {
+  std::vector<std::int32_t> out;
+  for (std::size_t f = 0; f < face_piece.size(); ++f)
+    if (face_piece[f] == p) out.push_back(static_cast<std::int32_t>(f));
+  return out;
+}
+
+Pieces label_pieces(const SkinnedMesh& mesh) {
+  std::vector<std::int32_t> parent(static_cast<std::size_t>(mesh.vertex_count()));
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const Face& f : mesh.faces) {
+    const std::int32_t a = find_root(parent, f[0]);
+    const std::int32_t b = find_root(parent, f[1]);
+    const std::int32_t c = find_root(parent, f[2]);
+    parent[static_cast<std::size_t>(b)] = a;
+    parent[static_cast<std::size_t>(c)] = a;
+    parent[static_cast<std::size_t>(find_root(parent, c))] = a;
+  }
+  Pieces p;
+  p.face_piece.resize(mesh.faces.size());
+  std::vector<std::int32_t> label(parent.size(), -1);
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const auto r = static_cast<std::size_t>(find_root(parent, mesh.faces[f][0]));
+    if (label[r] < 0) label[r] = p.count++;
+    p.face_piece[f] = label[r];
+  }
+  return p;
+}
+
+}  // namespace conform::mesh

@@ -1,0 +1,459 @@
+#include "conform/mesh/cut.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <stdexcept>
+
+#include "conform/cga/point.hpp"
+
+namespace conform::mesh {
+
+namespace {
+
+// The plane scaled to a unit normal; throws on a non-finite or zero normal.
+cga::Plane<double> unit_plane(const cga::Plane<double>& plane) {
+  const Eigen::Vector3d n = plane.normal();
+  const double len = n.norm();
+  if (!std::isfinite(len) || !std::isfinite(plane.distance()) || !(len > 0))
+    throw std::invalid_argument(
+        "cut: the plane must have a finite, non-zero normal and a finite distance");
+  return cga::Plane<double>::from_normal_distance(n / len, plane.distance() / len);
+}
+
+struct Pending {
+  Face v;    // after the separation remap
+  Face pre;  // before it (original and crossing-vertex ids)
+  std::int8_t side;
+  std::int32_t original;  // the face it re-indexes, or −1 for a piece of a split face
+  bool remapped = false;
+};
+
+std::int32_t root(std::vector<std::int32_t>& p, std::int32_t x) {
+  while (p[static_cast<std::size_t>(x)] != x)
+    x = p[static_cast<std::size_t>(x)] =
+        p[static_cast<std::size_t>(p[static_cast<std::size_t>(x)])];
+  return x;
+}
+
+// Ear clipping of a simple polygon given in 2D, keeping its orientation (each output triangle
+// turns the same way as the polygon). False when no ear can be found (not simple).
+bool ear_clip(const std::vector<Eigen::Vector2d>& p, std::vector<std::array<int, 3>>& out) {
+  const int n = static_cast<int>(p.size());
+  if (n < 3) return false;
+  double area = 0;
+  for (int i = 0; i < n; ++i) {
+    const auto& a = p[static_cast<std::size_t>(i)];
+    const auto& b = p[static_cast<std::size_t>((i + 1) % n)];
+    area += a.x() * b.y() - a.y() * b.x();
+  }
+  const double o = area > 0 ? 1.0 : -1.0;
+  auto cross = [&](int a, int b, int c) {
+    const Eigen::Vector2d u = p[static_cast<std::size_t>(b)] - p[static_cast<std::size_t>(a)];
+    const Eigen::Vector2d w = p[static_cast<std::size_t>(c)] - p[static_cast<std::size_t>(a)];
+    return o * (u.x() * w.y() - u.y() * w.x());
+  };
+  std::vector<int> idx(static_cast<std::size_t>(n));
+  std::iota(idx.begin(), idx.end(), 0);
+  double scale = 0;
+  for (const auto& q : p) scale = std::max(scale, q.cwiseAbs().maxCoeff());
+  const double eps = 1e-14 * scale * scale;
+  while (idx.size() > 3) {
+    const int m = static_cast<int>(idx.size());
+    bool clipped = false;
+    for (int i = 0; i < m && !clipped; ++i) {
+      const int a = idx[static_cast<std::size_t>((i + m - 1) % m)],
+                b = idx[static_cast<std::size_t>(i)],
+                c = idx[static_cast<std::size_t>((i + 1) % m)];
+      if (cross(a, b, c) <= eps) continue;  // reflex or flat: not an ear
+      bool inside = false;
+      for (int j = 0; j < m && !inside; ++j) {
+        const int q = idx[static_cast<std::size_t>(j)];
+        if (q == a || q == b || q == c) continue;
+        if (p[static_cast<std::size_t>(q)] == p[static_cast<std::size_t>(a)] ||
+            p[static_cast<std::size_t>(q)] == p[static_cast<std::size_t>(b)] ||
+            p[static_cast<std::size_t>(q)] == p[static_cast<std::size_t>(c)])
+          continue;
+        inside = cross(a, b, q) >= 0 && cross(b, c, q) >= 0 && cross(c, a, q) >= 0;
+      }
+      if (inside) continue;
+      out.push_back({a, b, c});
+      idx.erase(idx.begin() + i);
+      clipped = true;
+    }
+    if (!clipped) return false;
+  }
+  if (cross(idx[0], idx[1], idx[2]) > eps) {
+    out.push_back({idx[0], idx[1], idx[2]});
+    return true;
+  }
+  // The last three are collinear (collinear boundary points, e.g. along a flat face): the
+  // middle one b lies on the diagonal (a, c); flip that diagonal with the triangle across it,
+  // (a, c, d) → (a, b, d), (b, c, d).
+  for (int r = 0; r < 3; ++r) {
+    const int a = idx[static_cast<std::size_t>(r)], b = idx[static_cast<std::size_t>((r + 1) % 3)],
+              c = idx[static_cast<std::size_t>((r + 2) % 3)];
+    const Eigen::Vector2d ac = p[static_cast<std::size_t>(c)] - p[static_cast<std::size_t>(a)];
+    const double along = ac.dot(p[static_cast<std::size_t>(b)] - p[static_cast<std::size_t>(a)]);
+    if (!(along > 0 && along < ac.squaredNorm())) continue;  // b is not between a and c
+    for (auto& t : out)
+      for (int k = 0; k < 3; ++k)
+        if (t[static_cast<std::size_t>(k)] == a && t[static_cast<std::size_t>((k + 1) % 3)] == c) {
+          const int d = t[static_cast<std::size_t>((k + 2) % 3)];
+          if (cross(a, b, d) <= eps || cross(b, c, d) <= eps) return false;
+          t = {a, b, d};
+          out.push_back({b, c, d});
+          return true;
+        }
+  }
+  return false;
+}
+
+}  // namespace
+
+void classify_vertices(const SkinnedMesh& mesh, const cga::Plane<double>& plane_in,
+                       Predicates predicates, std::vector<double>& distance) {
+  const cga::Plane<double> plane = unit_plane(plane_in);
+  const Eigen::Index nv = mesh.current.cols();
+  distance.resize(static_cast<std::size_t>(nv));
+  if (predicates == Predicates::Cga) {
+    // X·Π with X = up(x): x·n − d (the ½x² e∞ and e0 parts meet Π's e∞ and zero e0).
+    for (Eigen::Index i = 0; i < nv; ++i)
+      distance[static_cast<std::size_t>(i)] =
+          dot(cga::Point<double>::up(Eigen::Vector3d(mesh.current.col(i))), plane);
+  } else {
+    const Eigen::Vector3d n = plane.normal();
+    const double d = plane.distance();
+    for (Eigen::Index i = 0; i < nv; ++i)
+      distance[static_cast<std::size_t>(i)] = n.dot(mesh.current.col(i)) - d;
+  }
+}
+
+CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_in,
+                      const CutOptions& options) {
+  const cga::Plane<double> plane = unit_plane(plane_in);
+  if (!(options.snap_fraction >= 0 && options.snap_fraction < 0.5) ||
+      !(options.plane_tolerance >= 0))
+    throw std::invalid_argument("cut: snap_fraction must be in [0, 0.5) and plane_tolerance ≥ 0");
+  if (mesh.current.cols() != mesh.vertex_count() || !mesh.current.allFinite())
+    throw std::invalid_argument("cut: the current positions must be finite, one per vertex");
+  const std::int32_t nv0 = mesh.vertex_count();
+  const std::int32_t nf0 = mesh.face_count();
+  CutResult result;
+  result.change.base_vertex_count = nv0;
+  result.change.base_face_count = nf0;
+  if (nf0 == 0) return result;
+
+  std::vector<double> dist;
+  classify_vertices(mesh, plane, options.predicates, dist);
+  const double eps = options.plane_tolerance * bounding_diagonal(mesh);
+  std::vector<std::int8_t> side(static_cast<std::size_t>(nv0));
+  bool any_pos = false, any_neg = false;
+  for (std::int32_t i = 0; i < nv0; ++i) {
+    const double s = dist[static_cast<std::size_t>(i)];
+    side[static_cast<std::size_t>(i)] = s > eps ? 1 : (s < -eps ? -1 : 0);
+    any_pos |= s > eps, any_neg |= s < -eps;
+  }
+  if (!any_pos || !any_neg) {
+    // Every vertex on one side or on the plane: only faces lying in the plane could separate,
+    // and they go to the side of the material (opposite their normal), i.e. the same side.
+    result.message = "the plane does not cross the mesh";
+    return result;
+  }
+  for (const Face& f : mesh.faces)
+    for (auto v : f)
+      if (v < 0 || v >= nv0) throw std::invalid_argument("cut: face index out of range");
+
+  // Snap crossings that fall too close to an end of their edge onto that end.
+  const double snap = options.snap_fraction;
+  for (const Face& f : mesh.faces)
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t a = std::min(f[k], f[(k + 1) % 3]), b = std::max(f[k], f[(k + 1) % 3]);
+      auto& sa = side[static_cast<std::size_t>(a)];
+      auto& sb = side[static_cast<std::size_t>(b)];
+      if (sa * sb >= 0) continue;
+      const double da = dist[static_cast<std::size_t>(a)], db = dist[static_cast<std::size_t>(b)];
+      const double t = da / (da - db);
+      if (t < snap)
+        sa = 0, ++result.snapped_vertices;
+      else if (t > 1 - snap)
+        sb = 0, ++result.snapped_vertices;
+    }
+
+  TopologyChange& ch = result.change;
+  EdgeMap crossing;  // (lower, higher) vertex → crossing vertex id
+  std::vector<Eigen::Vector3d> xpos;
+  auto cross_vertex = [&](std::int32_t u, std::int32_t w) {
+    const std::int32_t a = std::min(u, w), b = std::max(u, w);
+    std::int32_t id = crossing.find(a, b);
+    if (id >= 0) return id;
+    const double da = dist[static_cast<std::size_t>(a)], db = dist[static_cast<std::size_t>(b)];
+    const double t = da / (da - db);
+    id = nv0 + static_cast<std::int32_t>(ch.new_vertices.size());
+    ch.new_vertices.push_back(NewVertex::on_edge(a, b, t));
+    xpos.push_back((1 - t) * mesh.current.col(a) + t * mesh.current.col(b));
+    crossing.insert(a, b, id);
+    ++result.crossed_edges;
+    return id;
+  };
+  auto pos = [&](std::int32_t v) -> Eigen::Vector3d {
+    return v < nv0 ? Eigen::Vector3d(mesh.current.col(v)) : xpos[static_cast<std::size_t>(v - nv0)];
+  };
+
+  std::vector<Pending> pending;
+  std::vector<std::pair<std::int32_t, std::int32_t>>
+      on_plane;  // (vertex on the plane, pending index)
+  std::vector<std::int32_t> split;
+  bool face_pos = false, face_neg = false;
+  const Eigen::Vector3d n = plane.normal();
+  for (std::int32_t fi = 0; fi < nf0; ++fi) {
+    const Face& f = mesh.faces[static_cast<std::size_t>(fi)];
+    const std::int8_t s[3] = {side[static_cast<std::size_t>(f[0])],
+                              side[static_cast<std::size_t>(f[1])],
+                              side[static_cast<std::size_t>(f[2])]};
+    const bool crossed = s[0] * s[1] < 0 || s[1] * s[2] < 0 || s[2] * s[0] < 0;
+    if (!crossed) {
+      std::int8_t fs = s[0] != 0 ? s[0] : (s[1] != 0 ? s[1] : s[2]);
+      if (fs == 0) {
+        const Eigen::Vector3d a = mesh.current.col(f[0]);
+        const Eigen::Vector3d normal =
+            (mesh.current.col(f[1]) - a).cross(mesh.current.col(f[2]) - a);
+        fs = normal.dot(n) > 0 ? -1 : 1;
+      }
+      (fs > 0 ? face_pos : face_neg) = true;
+      if (s[0] != 0 && s[1] != 0 && s[2] != 0) continue;
+      const auto idx = static_cast<std::int32_t>(pending.size());
+      pending.push_back({f, f, fs, fi});
+      for (int k = 0; k < 3; ++k)
+        if (s[k] == 0) on_plane.emplace_back(f[k], idx);
+      continue;
+    }
+    face_pos = face_neg = true;
+    split.push_back(fi);
+    int zero = -1;
+    for (int k = 0; k < 3; ++k)
+      if (s[k] == 0) zero = k;
+    if (zero >= 0) {
+      const std::int32_t v0 = f[zero], v1 = f[(zero + 1) % 3], v2 = f[(zero + 2) % 3];
+      const std::int32_t x = cross_vertex(v1, v2);
+      const auto idx = static_cast<std::int32_t>(pending.size());
+      pending.push_back({{v0, v1, x}, {v0, v1, x}, s[(zero + 1) % 3], -1});
+      pending.push_back({{v0, x, v2}, {v0, x, v2}, s[(zero + 2) % 3], -1});
+      on_plane.emplace_back(v0, idx);
+      on_plane.emplace_back(v0, idx + 1);
+      continue;
+    }
+    int lone = 0;
+    for (int k = 0; k < 3; ++k)
+      if (s[(k + 1) % 3] == s[(k + 2) % 3]) lone = k;
+    const std::int32_t v0 = f[lone], v1 = f[(lone + 1) % 3], v2 = f[(lone + 2) % 3];
+    const std::int32_t x01 = cross_vertex(v0, v1), x20 = cross_vertex(v2, v0);
+    const std::int8_t s0 = s[lone];
+    const auto s1 = static_cast<std::int8_t>(-s0);
+    pending.push_back({{v0, x01, x20}, {v0, x01, x20}, s0, -1});
+    if ((pos(x01) - pos(v2)).squaredNorm() <= (pos(v1) - pos(x20)).squaredNorm()) {
+      pending.push_back({{x01, v1, v2}, {x01, v1, v2}, s1, -1});
+      pending.push_back({{x01, v2, x20}, {x01, v2, x20}, s1, -1});
+    } else {
+      pending.push_back({{x01, v1, x20}, {x01, v1, x20}, s1, -1});
+      pending.push_back({{v1, v2, x20}, {v1, v2, x20}, s1, -1});
+    }
+  }
+  if (!face_pos || !face_neg) {
+    ch.new_vertices.clear();
+    result.crossed_edges = 0;
+    result.message = "the plane only touches the mesh";
+    return result;
+  }
+
+  // Separate the fans around vertices on the plane: faces on one side sharing an edge through
+  // the vertex form a fan; the first positive fan keeps the vertex, every other fan gets a copy.
+  std::sort(on_plane.begin(), on_plane.end());
+  std::vector<std::int32_t> parent;
+  for (std::size_t i = 0; i < on_plane.size();) {
+    std::size_t j = i;
+    while (j < on_plane.size() && on_plane[j].first == on_plane[i].first) ++j;
+    const std::int32_t v = on_plane[i].first;
+    const auto m = static_cast<std::int32_t>(j - i);
+    parent.resize(static_cast<std::size_t>(m));
+    std::iota(parent.begin(), parent.end(), 0);
+    for (std::int32_t a = 0; a < m; ++a)
+      for (std::int32_t b = a + 1; b < m; ++b) {
+        const Pending& pa =
+            pending[static_cast<std::size_t>(on_plane[i + static_cast<std::size_t>(a)].second)];
+        const Pending& pb =
+            pending[static_cast<std::size_t>(on_plane[i + static_cast<std::size_t>(b)].second)];
+        if (pa.side != pb.side) continue;
+        bool shared = false;
+        for (auto x : pa.pre)
+          if (x != v && (x == pb.pre[0] || x == pb.pre[1] || x == pb.pre[2])) shared = true;
+        if (shared) parent[static_cast<std::size_t>(root(parent, a))] = root(parent, b);
+      }
+    std::int32_t keeper = -1;
+    for (std::int32_t a = 0; a < m && keeper < 0; ++a)
+      if (pending[static_cast<std::size_t>(on_plane[i + static_cast<std::size_t>(a)].second)].side >
+          0)
+        keeper = root(parent, a);
+    if (keeper < 0) keeper = root(parent, 0);
+    std::vector<std::pair<std::int32_t, std::int32_t>> copies;  // (fan root, copy id)
+    for (std::int32_t a = 0; a < m; ++a) {
+      const std::int32_t r = root(parent, a);
+      if (r == keeper) continue;
+      std::int32_t id = -1;
+      for (const auto& c : copies)
+        if (c.first == r) id = c.second;
+      if (id < 0) {
+        id = nv0 + static_cast<std::int32_t>(ch.new_vertices.size());
+        ch.new_vertices.push_back(NewVertex::duplicate(v));
+        copies.emplace_back(r, id);
+      }
+      Pending& p =
+          pending[static_cast<std::size_t>(on_plane[i + static_cast<std::size_t>(a)].second)];
+      for (auto& x : p.v)
+        if (x == v) x = id;
+      p.remapped = true;
+    }
+    i = j;
+  }
+  // Crossing vertices: the negative side uses a copy.
+  const auto nx = static_cast<std::int32_t>(xpos.size());
+  std::vector<std::int32_t> xcopy(static_cast<std::size_t>(nx));
+  for (std::int32_t k = 0; k < nx; ++k) {
+    xcopy[static_cast<std::size_t>(k)] = nv0 + static_cast<std::int32_t>(ch.new_vertices.size());
+    ch.new_vertices.push_back(NewVertex::duplicate(nv0 + k));
+  }
+  for (Pending& p : pending)
+    if (p.side < 0)
+      for (auto& x : p.v)
+        if (x >= nv0 && x < nv0 + nx) x = xcopy[static_cast<std::size_t>(x - nv0)];
+
+  for (const Pending& p : pending) {
+    if (p.original >= 0) {
+      if (!p.remapped) continue;
+      split.push_back(p.original);
+    }
+    ch.added_faces.push_back(p.v);
+    result.added_side.push_back(p.side);
+  }
+  std::sort(split.begin(), split.end());
+  ch.removed_faces = std::move(split);
+  result.status = CutStatus::Cut;
+
+  if (!options.cap) return result;
+
+  // Caps. The boundary of the positive side created by the cut: directed edges of positive
+  // pending faces between loop vertices (pre-remap ids) whose reverse no positive face has.
+  auto is_loop_vertex = [&](std::int32_t v) {
+    return v >= nv0 ? v < nv0 + nx : side[static_cast<std::size_t>(v)] == 0;
+  };
+  EdgeMap plus_edges;
+  for (const Pending& p : pending)
+    if (p.side > 0)
+      for (int k = 0; k < 3; ++k) plus_edges.insert(p.pre[k], p.pre[(k + 1) % 3], 1);
+  // Copy maps: pre-remap id → the id each side uses; conflicting entries make a loop ambiguous.
+  EdgeMap copy_of;  // key (vertex, side + 1) → id
+  std::vector<char> ambiguous_flag;
+  std::vector<std::int32_t> ambiguous;
+  for (const Pending& p : pending)
+    for (int k = 0; k < 3; ++k) {
+      if (!is_loop_vertex(p.pre[k])) continue;
+      if (!copy_of.insert(p.pre[k], p.side + 1, p.v[k]) &&
+          copy_of.find(p.pre[k], p.side + 1) != p.v[k])
+        ambiguous.push_back(p.pre[k]);
+    }
+  std::sort(ambiguous.begin(), ambiguous.end());
+  EdgeMap next;  // boundary edge u → v, keyed (u, 0)
+  std::vector<std::int32_t> starts;
+  bool branching = false;
+  for (const Pending& p : pending) {
+    if (p.side <= 0) continue;
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t u = p.pre[k], w = p.pre[(k + 1) % 3];
+      if (!is_loop_vertex(u) || !is_loop_vertex(w) || plus_edges.find(w, u) >= 0) continue;
+      if (!next.insert(u, 0, w)) branching = true;
+      starts.push_back(u);
+    }
+  }
+  EdgeMap visited;
+  std::vector<std::string> problems;
+  const Eigen::Vector3d e1 = n.unitOrthogonal(), e2 = n.cross(e1);
+  for (auto s0 : starts) {
+    if (visited.find(s0, 0) >= 0) continue;
+    std::vector<std::int32_t> loop;
+    std::int32_t u = s0;
+    bool closed = false;
+    while (u >= 0 && visited.find(u, 0) < 0) {
+      visited.insert(u, 0, 1);
+      loop.push_back(u);
+      u = next.find(u, 0);
+      if (u == s0) closed = true;
+    }
+    if (!closed) {
+      problems.push_back("an open cut curve (the surface has a boundary there)");
+      continue;
+    }
+    ++result.loops;
+    bool amb = branching;
+    for (auto v : loop) amb |= std::binary_search(ambiguous.begin(), ambiguous.end(), v);
+    if (amb) {
+      problems.push_back(
+          "a cut loop through a vertex where the surface touches the plane in several fans");
+      continue;
+    }
+    // The positive piece's cap turns opposite to its boundary: triangulate the reversed loop.
+    std::reverse(loop.begin(), loop.end());
+    std::vector<Eigen::Vector2d> p2;
+    for (auto v : loop) {
+      const Eigen::Vector3d x = pos(v);
+      p2.emplace_back(x.dot(e1), x.dot(e2));
+    }
+    double area = 0;
+    for (std::size_t i = 0; i < p2.size(); ++i) {
+      const auto& a = p2[i];
+      const auto& b = p2[(i + 1) % p2.size()];
+      area += a.x() * b.y() - a.y() * b.x();
+    }
+    std::vector<std::array<int, 3>> tris;
+    if (area >= 0) {
+      // A reversed boundary turning counter-clockwise about n bounds a hole of the section
+      // (a loop inside another); holes are not bridged here.
+      problems.push_back("a cut loop that is a hole in the cross-section");
+      continue;
+    }
+    if (!ear_clip(p2, tris)) {
+      problems.push_back("a cut loop whose projection is not a simple polygon");
+      continue;
+    }
+    ++result.capped_loops;
+    for (const auto& t : tris) {
+      Face plus, minus;
+      for (int k = 0; k < 3; ++k) {
+        const std::int32_t v = loop[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])];
+        plus[k] = copy_of.find(v, 2);
+        minus[2 - k] = copy_of.find(v, 0);
+      }
+      if (plus[0] >= 0 && plus[1] >= 0 && plus[2] >= 0) {
+        ch.added_faces.push_back(plus);
+        result.added_side.push_back(1);
+      }
+      if (minus[0] >= 0 && minus[1] >= 0 && minus[2] >= 0) {
+        ch.added_faces.push_back(minus);
+        result.added_side.push_back(-1);
+      }
+      ++result.cap_faces;
+    }
+  }
+  if (!problems.empty()) result.message = "not capped: " + problems.front();
+  return result;
+}
+
+CutOutcome cut(SkinnedMesh& mesh, Adjacency& adjacency, const cga::Plane<double>& plane,
+               const CutOptions& options) {
+  CutOutcome out;
+  out.result = compute_cut(mesh, plane, options);
+  if (out.result.status == CutStatus::Cut) apply(mesh, out.result.change, &adjacency);
+  out.pieces = label_pieces(mesh);
+  return out;
+}
+
+}  // namespace conform::mesh

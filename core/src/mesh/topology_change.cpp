@@ -1,0 +1,183 @@
+#include "conform/mesh/topology_change.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace conform::mesh {
+
+std::string TopologyChange::validate() const {
+  if (base_vertex_count < 0 || base_face_count < 0) return "negative base counts";
+  const std::int64_t nv = std::int64_t(base_vertex_count) + std::int64_t(new_vertices.size());
+  for (std::size_t i = 0; i < new_vertices.size(); ++i) {
+    const NewVertex& v = new_vertices[i];
+    const std::int64_t self = std::int64_t(base_vertex_count) + std::int64_t(i);
+    double sum = 0;
+    for (int k = 0; k < 3; ++k) {
+      if (v.parents[k] < 0) {
+        if (k == 0) return "new vertex " + std::to_string(i) + " has no parent";
+        if (v.coefficients[k] != 0)
+          return "new vertex " + std::to_string(i) + ": coefficient without parent";
+        continue;
+      }
+      if (v.parents[k] >= self)
+        return "new vertex " + std::to_string(i) + " refers to a later vertex";
+      if (!std::isfinite(v.coefficients[k]))
+        return "new vertex " + std::to_string(i) + ": non-finite coefficient";
+      sum += v.coefficients[k];
+    }
+    if (std::abs(sum - 1) > 1e-12)
+      return "new vertex " + std::to_string(i) + ": coefficients do not sum to 1";
+    if (!v.displacement.allFinite())
+      return "new vertex " + std::to_string(i) + ": non-finite displacement";
+  }
+  for (std::size_t i = 0; i < removed_faces.size(); ++i) {
+    if (removed_faces[i] < 0 || removed_faces[i] >= base_face_count)
+      return "removed face out of range";
+    if (i > 0 && removed_faces[i] <= removed_faces[i - 1])
+      return "removed faces not strictly increasing";
+  }
+  for (const Face& f : added_faces) {
+    for (auto v : f)
+      if (v < 0 || v >= nv) return "added face refers to a vertex out of range";
+    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) return "added face repeats a vertex";
+  }
+  return {};
+}
+
+std::int32_t TopologyChange::face_after(std::int32_t f) const {
+  const auto it = std::lower_bound(removed_faces.begin(), removed_faces.end(), f);
+  const bool removed = it != removed_faces.end() && *it == f;
+  const std::size_t filled = std::min(removed_faces.size(), added_faces.size());
+  if (removed) return -1;  // even a refilled slot now holds an added face, not f
+  // Simulate step 3 for the base face f: it moves only if it is the last face when a slot is
+  // filled. Few slots remain, so this walks them directly.
+  std::int32_t count = base_face_count + static_cast<std::int32_t>(added_faces.size() - filled);
+  std::int32_t where = f;
+  for (std::size_t k = removed_faces.size(); k-- > filled;) {
+    const std::int32_t slot = removed_faces[k];
+    if (where == count - 1 && slot != count - 1) where = slot;
+    --count;
+  }
+  return where;
+}
+
+void blend_influences(SkinnedMesh& mesh, const std::array<std::int32_t, 3>& parents,
+                      const std::array<double, 3>& coefficients, std::int32_t out) {
+  std::array<std::int32_t, 3 * kMaxInfluences> bone{};
+  std::array<double, 3 * kMaxInfluences> weight{};
+  int n = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (parents[k] < 0 || coefficients[k] == 0) continue;
+    for (int j = 0; j < kMaxInfluences; ++j) {
+      const double w = mesh.weights(j, parents[k]);
+      if (w == 0) continue;
+      const std::int32_t b = mesh.bones(j, parents[k]);
+      int i = 0;
+      while (i < n && bone[i] != b) ++i;
+      if (i == n) bone[n] = b, weight[n] = 0, ++n;
+      weight[i] += coefficients[k] * w;
+    }
+  }
+  std::array<int, 3 * kMaxInfluences> order{};
+  for (int i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.begin() + n, [&](int a, int b) {
+    return weight[a] > weight[b] || (weight[a] == weight[b] && bone[a] < bone[b]);
+  });
+  const int keep = std::min(n, kMaxInfluences);
+  double sum = 0;
+  for (int i = 0; i < keep; ++i) sum += std::max(0.0, weight[order[i]]);
+  for (int j = 0; j < kMaxInfluences; ++j) {
+    if (j < keep && sum > 0 && weight[order[j]] > 0) {
+      mesh.bones(j, out) = bone[order[j]];
+      mesh.weights(j, out) = weight[order[j]] / sum;
+    } else {
+      mesh.bones(j, out) = 0;
+      mesh.weights(j, out) = 0;
+    }
+  }
+}
+
+void apply(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency) {
+  if (change.base_vertex_count != mesh.vertex_count() ||
+      change.base_face_count != mesh.face_count())
+    throw std::invalid_argument("apply: the change was computed for a mesh of other counts");
+  if (adjacency && !adjacency->matches(mesh))
+    throw std::invalid_argument("apply: the adjacency does not describe this mesh");
+  if (const std::string problem = change.validate(); !problem.empty())
+    throw std::invalid_argument("apply: " + problem);
+  apply_vertices(mesh, change);
+  apply_faces(mesh, change, adjacency);
+}
+
+void apply_vertices(SkinnedMesh& mesh, const TopologyChange& change) {
+  // Vertices: grow every per-vertex array, then fill the new columns in order (a new vertex may
+  // have earlier new vertices as parents).
+  const std::int32_t nv0 = mesh.vertex_count();
+  const auto nnew = static_cast<std::int32_t>(change.new_vertices.size());
+  const std::int32_t nv = nv0 + nnew;
+  const bool uvs = mesh.has_uvs(), normals = mesh.has_normals();
+  const bool skin = mesh.bones.cols() == nv0 && mesh.weights.cols() == nv0;
+  if (nnew > 0) {
+    mesh.rest.conservativeResize(3, nv);
+    mesh.current.conservativeResize(3, nv);
+    if (skin)
+      mesh.bones.conservativeResize(kMaxInfluences, nv),
+          mesh.weights.conservativeResize(kMaxInfluences, nv);
+    if (uvs) mesh.uvs.conservativeResize(2, nv);
+    if (normals) mesh.normals.conservativeResize(3, nv);
+    for (std::int32_t i = 0; i < nnew; ++i) {
+      const NewVertex& v = change.new_vertices[static_cast<std::size_t>(i)];
+      const std::int32_t o = nv0 + i;
+      Eigen::Vector3d rest = Eigen::Vector3d::Zero(), cur = Eigen::Vector3d::Zero(),
+                      n = Eigen::Vector3d::Zero();
+      Eigen::Vector2d uv = Eigen::Vector2d::Zero();
+      for (int k = 0; k < 3; ++k) {
+        if (v.parents[k] < 0) continue;
+        const double c = v.coefficients[k];
+        rest += c * mesh.rest.col(v.parents[k]);
+        cur += c * mesh.current.col(v.parents[k]);
+        if (uvs) uv += c * mesh.uvs.col(v.parents[k]);
+        if (normals) n += c * mesh.normals.col(v.parents[k]);
+      }
+      mesh.rest.col(o) = rest;
+      mesh.current.col(o) = cur + v.displacement;
+      if (uvs) mesh.uvs.col(o) = uv;
+      if (normals) {
+        const double len = n.norm();
+        mesh.normals.col(o) = len > 1e-300 ? Eigen::Vector3d(n / len)
+                                           : Eigen::Vector3d(mesh.normals.col(v.parents[0]));
+      }
+      if (skin) blend_influences(mesh, v.parents, v.coefficients, o);
+    }
+  }
+}
+
+void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency) {
+  // Faces, in the documented slot order.
+  const auto& removed = change.removed_faces;
+  const auto& added = change.added_faces;
+  if (adjacency)
+    for (auto f : removed) adjacency->remove_face(mesh, f);
+  const std::size_t filled = std::min(removed.size(), added.size());
+  for (std::size_t k = 0; k < filled; ++k) {
+    mesh.faces[static_cast<std::size_t>(removed[k])] = added[k];
+    if (adjacency) adjacency->add_face(mesh, removed[k]);
+  }
+  for (std::size_t k = filled; k < added.size(); ++k) {
+    mesh.faces.push_back(added[k]);
+    if (adjacency) adjacency->add_face(mesh, mesh.face_count() - 1);
+  }
+  for (std::size_t k = removed.size(); k-- > filled;) {
+    const std::int32_t slot = removed[k];
+    const std::int32_t last = mesh.face_count() - 1;
+    if (slot != last) {
+      mesh.faces[static_cast<std::size_t>(slot)] = mesh.faces.back();
+      if (adjacency) adjacency->move_face(mesh, last, slot);
+    }
+    mesh.faces.pop_back();
+    if (adjacency) adjacency->resize_faces(mesh.face_count());
+  }
+}
+
+}  // namespace conform::mesh

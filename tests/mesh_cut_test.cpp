@@ -1,0 +1,402 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "conform/cga/versor.hpp"
+#include "conform/mesh/analysis.hpp"
+#include "conform/mesh/cut.hpp"
+#include "conform/mesh/primitives.hpp"
+#include "conform/mesh/procedural_arm.hpp"
+
+using namespace conform;
+using namespace conform::mesh;
+using Plane = cga::Plane<double>;
+
+namespace {
+
+// Invariants every cut must keep (the input being closed/manifold/oriented where stated).
+void expect_valid(const SkinnedMesh& m, const SkinnedMesh& input, const std::string& what) {
+  const MeshReport before = check_mesh(input);
+  const MeshReport r = check_mesh(m, 1e-14 * std::pow(bounding_diagonal(input), 2));
+  EXPECT_TRUE(r.indices_valid) << what;
+  EXPECT_TRUE(r.finite) << what;
+  EXPECT_EQ(r.tiny_faces, 0) << what;
+  if (before.manifold()) {
+    EXPECT_EQ(r.overused_edges, 0) << what;
+    EXPECT_EQ(r.nonmanifold_vertices, 0) << what << ": " << r.summary();
+  }
+  if (before.oriented()) {
+    EXPECT_EQ(r.misoriented_edges, 0) << what;
+  }
+  // Skinning data stays well formed.
+  for (Eigen::Index v = 0; v < m.weights.cols(); ++v) {
+    EXPECT_NEAR(m.weights.col(v).sum(), 1.0, 1e-12) << what;
+    for (int k = 1; k < kMaxInfluences; ++k)
+      EXPECT_GE(m.weights(k - 1, v), m.weights(k, v)) << what;
+  }
+}
+
+Plane random_plane(std::mt19937& rng, const SkinnedMesh& m) {
+  std::normal_distribution<double> g;
+  const Eigen::Vector3d lo = m.current.rowwise().minCoeff(), hi = m.current.rowwise().maxCoeff();
+  std::uniform_real_distribution<double> u(0, 1);
+  const Eigen::Vector3d point =
+      lo + (hi - lo).cwiseProduct(Eigen::Vector3d(u(rng), u(rng), u(rng)));
+  Eigen::Vector3d n(g(rng), g(rng), g(rng));
+  return Plane::from_normal_point(n, point);
+}
+
+// The areas of the pieces (cap faces excluded) add up to the input's area.
+void expect_area_kept(const SkinnedMesh& input, const SkinnedMesh& out, const CutResult& r,
+                      const std::string& what) {
+  double cap_area = 0;
+  const auto base = r.change.base_face_count;
+  (void)base;
+  std::vector<std::int32_t> caps;
+  // Cap faces are the last 2 × cap_faces added faces when capping succeeded.
+  const auto nadded = static_cast<std::int32_t>(r.change.added_faces.size());
+  for (std::int32_t k = nadded - 2 * r.cap_faces; k < nadded; ++k) {
+    const Face& f = r.change.added_faces[static_cast<std::size_t>(k)];
+    const Eigen::Vector3d a = out.current.col(f[0]);
+    cap_area += 0.5 * (out.current.col(f[1]) - a).cross(out.current.col(f[2]) - a).norm();
+  }
+  const double a0 = surface_area(input);
+  EXPECT_NEAR(surface_area(out) - cap_area, a0, 1e-9 * a0) << what;
+}
+
+}  // namespace
+
+TEST(Cut, IcosphereInTwoWithInvariants) {
+  const SkinnedMesh in = make_icosphere(3);
+  SkinnedMesh m = in;
+  Adjacency adj(m);
+  const auto out = cut(m, adj, Plane::from_normal_distance({0.2, 0.1, 1.0}, 0.13));
+  ASSERT_EQ(out.result.status, CutStatus::Cut);
+  EXPECT_EQ(out.pieces.count, 2);
+  EXPECT_GT(out.result.crossed_edges, 10);
+  expect_valid(m, in, "icosphere");
+  expect_area_kept(in, m, out.result, "icosphere");
+  // Each piece lies on one side of the plane (up to the snap distance).
+  const Plane p = Plane::from_normal_distance({0.2, 0.1, 1.0}, 0.13);
+  for (std::int32_t piece = 0; piece < 2; ++piece) {
+    double lo = 1e9, hi = -1e9;
+    for (auto f : out.pieces.faces_of(piece))
+      for (auto v : m.faces[static_cast<std::size_t>(f)]) {
+        lo = std::min(lo, p.signed_distance(m.current.col(v)));
+        hi = std::max(hi, p.signed_distance(m.current.col(v)));
+      }
+    EXPECT_TRUE(lo > -0.02 || hi < 0.02) << lo << " " << hi;
+  }
+  // The adjacency kept up to date equals one rebuilt from scratch.
+  Adjacency fresh(m);
+  for (std::int32_t h = 0; h < 3 * m.face_count(); ++h) ASSERT_EQ(adj.twin(h), fresh.twin(h)) << h;
+}
+
+TEST(Cut, CapsCloseEveryPieceAndKeepVolume) {
+  const SkinnedMesh in = make_icosphere(3);
+  SkinnedMesh m = in;
+  Adjacency adj(m);
+  const auto out = cut(m, adj, Plane::from_normal_distance({1, -0.3, 0.4}, -0.2), {.cap = true});
+  ASSERT_EQ(out.result.status, CutStatus::Cut);
+  EXPECT_EQ(out.result.loops, 1);
+  EXPECT_EQ(out.result.capped_loops, 1) << out.result.message;
+  ASSERT_EQ(out.pieces.count, 2);
+  const double v0 = signed_volume(in);
+  double v = 0;
+  for (std::int32_t p = 0; p < out.pieces.count; ++p) {
+    const auto faces = out.pieces.faces_of(p);
+    SkinnedMesh piece = m;
+    piece.faces.clear();
+    for (auto f : faces) piece.faces.push_back(m.faces[static_cast<std::size_t>(f)]);
+    const MeshReport r = check_mesh(piece);
+    EXPECT_TRUE(r.closed()) << r.summary();
+    EXPECT_TRUE(r.oriented());
+    EXPECT_TRUE(r.manifold()) << r.summary();
+    EXPECT_GT(signed_volume(piece), 0);
+    v += signed_volume(piece);
+  }
+  EXPECT_NEAR(v, v0, 1e-9 * v0);
+  expect_area_kept(in, m, out.result, "capped icosphere");
+  expect_valid(m, in, "capped icosphere");
+}
+
+TEST(Cut, OnePlaneManyPieces) {
+  // A U-shaped tube (the cylinder bent by hand) cut across both legs gives three pieces.
+  SkinnedMesh m = make_cylinder(24, 40, 0.1, 2.0);
+  for (Eigen::Index v = 0; v < m.current.cols(); ++v) {
+    const double z = m.rest(2, v), a = z / 2.0 * M_PI;  // bend the axis along a half circle
+    const double x = m.rest(0, v);
+    m.current(0, v) = (0.5 + x) * std::cos(a);
+    m.current(2, v) = (0.5 + x) * std::sin(a);
+  }
+  const SkinnedMesh in = m;
+  Adjacency adj(m);
+  const auto out = cut(m, adj, Plane::from_normal_distance({0, 0, 1}, 0.2), {.cap = true});
+  ASSERT_EQ(out.result.status, CutStatus::Cut);
+  EXPECT_EQ(out.pieces.count, 3);
+  EXPECT_EQ(out.result.capped_loops, 2) << out.result.message;
+  expect_valid(m, in, "U tube");
+  expect_area_kept(in, m, out.result, "U tube");
+}
+
+TEST(Cut, PropertyRandomPlanes) {
+  struct Model {
+    std::string name;
+    SkinnedMesh mesh;
+    bool closed;
+  };
+  std::vector<Model> models = {{"icosphere", make_icosphere(3), true},
+                               {"sheet", make_sheet(30, 20), false},
+                               {"cylinder", make_cylinder(32, 20, 0.2, 1.0), true},
+                               {"arm", make_arm(1).mesh, true}};
+  std::mt19937 rng(1234);
+  int cuts = 0, capped_all = 0;
+  for (const Model& model : models) {
+    for (int trial = 0; trial < 300; ++trial) {
+      SkinnedMesh m = model.mesh;
+      Adjacency adj(m);
+      const Plane p = random_plane(rng, m);
+      const bool cap = trial % 2 == 0;
+      const auto out = cut(m, adj, p, {.cap = cap});
+      const std::string what = model.name + " trial " + std::to_string(trial);
+      if (out.result.status != CutStatus::Cut) {
+        EXPECT_TRUE(out.result.change.empty()) << what;
+        EXPECT_EQ(m.faces, model.mesh.faces) << what;
+        continue;
+      }
+      ++cuts;
+      EXPECT_GE(out.pieces.count, 2) << what;
+      expect_valid(m, model.mesh, what);
+      expect_area_kept(model.mesh, m, out.result, what);
+      if (cap && model.closed && out.result.capped_loops == out.result.loops) {
+        ++capped_all;
+        const MeshReport r = check_mesh(m);
+        EXPECT_TRUE(r.closed()) << what << ": " << r.summary();
+        double v = 0;
+        for (std::int32_t piece = 0; piece < out.pieces.count; ++piece)
+          v += signed_volume(m, out.pieces.faces_of(piece));
+        const double v0 = signed_volume(model.mesh);
+        EXPECT_NEAR(v, v0, 1e-9 * std::abs(v0)) << what;
+      }
+    }
+  }
+  EXPECT_GT(cuts, 600);
+  EXPECT_GT(capped_all, 200);
+}
+
+TEST(Cut, NewVerticesCarryAttributesAndWeights) {
+  const SkinnedMesh in = make_cylinder(16, 12, 0.3, 1.0);
+  SkinnedMesh m = in;
+  Adjacency adj(m);
+  const auto out = cut(m, adj, Plane::from_normal_distance({0.1, 0, 1}, 0.37));
+  ASSERT_EQ(out.result.status, CutStatus::Cut);
+  const auto& nvs = out.result.change.new_vertices;
+  for (std::size_t i = 0; i < nvs.size(); ++i) {
+    const auto v = static_cast<Eigen::Index>(in.vertex_count() + static_cast<std::int32_t>(i));
+    const NewVertex& nv = nvs[i];
+    if (nv.is_duplicate()) {
+      EXPECT_EQ(m.rest.col(v), m.rest.col(nv.parents[0]));
+      EXPECT_EQ(m.weights.col(v), m.weights.col(nv.parents[0]));
+      continue;
+    }
+    const double t = nv.coefficients[1];
+    EXPECT_GE(t, 0.01);
+    EXPECT_LE(t, 0.99);
+    const auto a = nv.parents[0], b = nv.parents[1];
+    EXPECT_LT((m.rest.col(v) - ((1 - t) * in.rest.col(a) + t * in.rest.col(b))).norm(), 1e-14);
+    EXPECT_LT((m.uvs.col(v) - ((1 - t) * in.uvs.col(a) + t * in.uvs.col(b))).norm(), 1e-14);
+    EXPECT_NEAR(m.normals.col(v).norm(), 1.0, 1e-12);
+    // §4.3: the blended weight of each bone (no more than 3 bones here, so no truncation).
+    for (int bone = 0; bone < 3; ++bone) {
+      auto w = [&](const SkinnedMesh& mm, Eigen::Index x) {
+        double s = 0;
+        for (int k = 0; k < kMaxInfluences; ++k)
+          if (mm.bones(k, x) == bone) s += mm.weights(k, x);
+        return s;
+      };
+      EXPECT_NEAR(w(m, v), (1 - t) * w(in, a) + t * w(in, b), 1e-12);
+    }
+  }
+}
+
+TEST(Cut, WeightsKeepFourLargestAndRenormalize) {
+  SkinnedMesh m = make_sheet(1, 1);
+  m.bones.col(0) << 0, 1, 2, 3;
+  m.weights.col(0) << 0.4, 0.3, 0.2, 0.1;
+  m.bones.col(2) << 4, 5, 6, 7;
+  m.weights.col(2) << 0.7, 0.1, 0.1, 0.1;
+  m.bones.conservativeResize(4, 5);
+  m.weights.conservativeResize(4, 5);
+  m.rest.conservativeResize(3, 5);
+  m.current.conservativeResize(3, 5);
+  m.uvs.resize(0, 0);
+  m.normals.resize(0, 0);
+  blend_influences(m, {0, 2, -1}, {0.5, 0.5, 0}, 4);
+  // Blend: 0:.2 1:.15 2:.1 3:.05 4:.35 5:.05 6:.05 7:.05 → keep 4, 0, 1, 2 → renormalize by .8.
+  EXPECT_EQ(m.bones(0, 4), 4);
+  EXPECT_EQ(m.bones(1, 4), 0);
+  EXPECT_EQ(m.bones(2, 4), 1);
+  EXPECT_EQ(m.bones(3, 4), 2);
+  EXPECT_NEAR(m.weights(0, 4), 0.35 / 0.8, 1e-15);
+  EXPECT_NEAR(m.weights(3, 4), 0.1 / 0.8, 1e-15);
+}
+
+TEST(Cut, DegenerateInputs) {
+  const SkinnedMesh in = make_icosphere(2);
+  {  // plane missing the mesh: documented no-op
+    SkinnedMesh m = in;
+    Adjacency adj(m);
+    const auto out = cut(m, adj, Plane::from_normal_distance({0, 0, 1}, 5));
+    EXPECT_EQ(out.result.status, CutStatus::Missed);
+    EXPECT_TRUE(out.result.change.empty());
+    EXPECT_EQ(out.pieces.count, 1);
+  }
+  {  // tangent at the north pole (a vertex): touches only
+    SkinnedMesh m = make_icosphere(0);
+    const Eigen::Vector3d top = m.current.col(0);
+    Adjacency adj(m);
+    const auto out = cut(m, adj, Plane::from_normal_point(top, top));
+    EXPECT_EQ(out.result.status, CutStatus::Missed);
+  }
+  {  // NaN and zero normals, NaN positions: clear errors, mesh untouched
+    SkinnedMesh m = in;
+    Adjacency adj(m);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    Plane bad;
+    bad.e1 = nan, bad.e3 = 1;
+    EXPECT_THROW(cut(m, adj, bad), std::invalid_argument);
+    Plane zero;
+    EXPECT_THROW(cut(m, adj, zero), std::invalid_argument);
+    SkinnedMesh broken = in;
+    broken.current(0, 3) = nan;
+    EXPECT_THROW(compute_cut(broken, Plane::from_normal_distance({0, 0, 1}, 0)),
+                 std::invalid_argument);
+    EXPECT_EQ(m.faces, in.faces);
+  }
+  {  // plane through vertices (the icosphere's equator has vertices at z = 0) and along edges
+    SkinnedMesh s = make_sheet(10, 10);
+    const SkinnedMesh s0 = s;
+    Adjacency adj(s);
+    const auto out = cut(s, adj, Plane::from_normal_distance({1, 0, 0}, 0.0));  // a grid line
+    ASSERT_EQ(out.result.status, CutStatus::Cut);
+    EXPECT_EQ(out.result.crossed_edges, 0);
+    EXPECT_EQ(out.pieces.count, 2);
+    expect_valid(s, s0, "sheet along edges");
+    expect_area_kept(s0, s, out.result, "sheet along edges");
+    SkinnedMesh e = in;
+    Adjacency adj2(e);
+    const auto out2 = cut(e, adj2, Plane::from_normal_distance({0, 0, 1}, 0.0), {.cap = true});
+    ASSERT_EQ(out2.result.status, CutStatus::Cut);
+    EXPECT_EQ(out2.pieces.count, 2);
+    EXPECT_EQ(out2.result.capped_loops, 1) << out2.result.message;
+    expect_valid(e, in, "equator");
+    EXPECT_TRUE(check_mesh(e).closed());
+  }
+  {  // coplanar faces: a flat sheet in the cutting plane is a no-op; a cylinder's cap plane too
+    SkinnedMesh s = make_sheet(4, 4);
+    Adjacency adj(s);
+    EXPECT_EQ(cut(s, adj, Plane::from_normal_distance({0, 0, 1}, 0.0)).result.status,
+              CutStatus::Missed);
+    SkinnedMesh c = make_cylinder(8, 4, 0.5, 1.0);
+    Adjacency adjc(c);
+    EXPECT_EQ(cut(c, adjc, Plane::from_normal_distance({0, 0, 1}, 1.0)).result.status,
+              CutStatus::Missed);
+  }
+  {  // a plane through a ring of the cylinder (vertices and edges in the plane), capped
+    SkinnedMesh c = make_cylinder(12, 6, 0.5, 1.0);
+    const SkinnedMesh c0 = c;
+    Adjacency adj(c);
+    const auto out = cut(c, adj, Plane::from_normal_distance({0, 0, 1}, 0.5), {.cap = true});
+    ASSERT_EQ(out.result.status, CutStatus::Cut);
+    EXPECT_EQ(out.pieces.count, 2);
+    EXPECT_EQ(out.result.capped_loops, 1) << out.result.message;
+    expect_valid(c, c0, "ring");
+    EXPECT_TRUE(check_mesh(c).closed());
+  }
+}
+
+TEST(Cut, SnappingAvoidsSlivers) {
+  SkinnedMesh s = make_sheet(10, 10);
+  const SkinnedMesh s0 = s;
+  Adjacency adj(s);
+  // 0.1 % of an edge away from a grid line: snapped onto it rather than making needles.
+  const auto out = cut(s, adj, Plane::from_normal_distance({1, 0, 0}, 0.0001));
+  ASSERT_EQ(out.result.status, CutStatus::Cut);
+  EXPECT_GT(out.result.snapped_vertices, 0);
+  double min_ratio = 1;
+  for (const Face& f : s.faces) {
+    const Eigen::Vector3d a = s.current.col(f[0]);
+    min_ratio = std::min(
+        min_ratio, 0.5 * (s.current.col(f[1]) - a).cross(s.current.col(f[2]) - a).norm() / 0.005);
+  }
+  EXPECT_GT(min_ratio, 0.01 * 0.01);
+  expect_valid(s, s0, "snapped");
+}
+
+// Linear-blend skinning with one versor per bone, applied through the weights.
+Eigen::Matrix3Xd lbs(const SkinnedMesh& m, const std::vector<cga::Versor<double>>& pose) {
+  Eigen::Matrix3Xd out(3, m.rest.cols());
+  for (Eigen::Index v = 0; v < m.rest.cols(); ++v) {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int k = 0; k < kMaxInfluences; ++k)
+      if (m.weights(k, v) != 0)
+        x += m.weights(k, v) * pose[static_cast<std::size_t>(m.bones(k, v))].apply(m.rest.col(v));
+    out.col(v) = x;
+  }
+  return out;
+}
+
+TEST(Cut, ReDeformation) {
+  // Cut the posed mesh, then re-skin the result with another pose, against skinning the
+  // original with that pose and applying the same change.
+  const SkinnedMesh original = make_arm(1).mesh;
+  using V = cga::Versor<double>;
+  using M = cga::Motor<double>;
+  const std::vector<V> pose1 = {V::identity(), V::from_motor(M::from_axis_angle({1, 0, 0}, 0.4)),
+                                V{M::from_axis_angle({0, 1, 0}, 0.3), 1.1}};
+  const std::vector<V> pose2 = {V::from_motor(M::from_translation({0.1, 0, 0})),
+                                V::from_motor(M::from_axis_angle({1, 1, 0}, -0.7)),
+                                V{M::from_axis_angle({0, 0, 1}, 0.5), 0.8}};
+  SkinnedMesh posed = original;
+  posed.current = lbs(original, pose1);
+  for (const double z : {0.12, 0.31, 0.5, 0.58}) {  // upper arm, elbow, forearm/wrist blend, hand
+    SkinnedMesh a = posed;
+    Adjacency adj(a);
+    const auto out = cut(a, adj, Plane::from_normal_point({0.2, 0.1, 1}, {0, 0, z}), {.cap = true});
+    ASSERT_EQ(out.result.status, CutStatus::Cut);
+    a.current = lbs(a, pose2);  // re-skin the changed mesh
+    SkinnedMesh b = original;
+    b.current = lbs(original, pose2);
+    apply(b, out.result.change);  // the same change applied to the re-posed original
+    ASSERT_EQ(a.vertex_count(), b.vertex_count());
+    EXPECT_EQ(a.faces, b.faces);
+    double worst_same = 0, worst_blend = 0;
+    std::vector<char> exact;
+    for (Eigen::Index v = 0; v < a.current.cols(); ++v) {
+      const double err = (a.current.col(v) - b.current.col(v)).norm();
+      // New vertices whose parents have the same influences deform exactly like their
+      // parents' interpolation; where the influences differ, LBS of an interpolated point is
+      // not the interpolation of LBS'd points (a t(1 − t) term), so only closeness holds.
+      bool same = true;
+      if (v >= original.vertex_count()) {
+        const auto& nv =
+            out.result.change.new_vertices[static_cast<std::size_t>(v - original.vertex_count())];
+        if (nv.is_duplicate()) {
+          same = exact[static_cast<std::size_t>(nv.parents[0])];
+        } else {
+          for (int k = 1; k < 3; ++k)
+            if (nv.parents[k] >= 0 &&
+                (a.weights.col(nv.parents[k]) != a.weights.col(nv.parents[0]) ||
+                 a.bones.col(nv.parents[k]) != a.bones.col(nv.parents[0])))
+              same = false;
+        }
+      }
+      exact.push_back(same);
+      (same ? worst_same : worst_blend) = std::max(same ? worst_same : worst_blend, err);
+    }
+    EXPECT_LT(worst_same, 1e-9) << "z " << z;
+    EXPECT_LT(worst_blend, 2e-3) << "z " << z;  // well under the arm's 6 mm ring spacing
+  }
+}
