@@ -15,10 +15,10 @@ DualQuaternion<T> to_dq(const Motor<T>& m) {
 
 template <class T>
 Motor<T> from_dq(const Quat<T>& r, const Quat<T>& d) {
-  Multivector<T> mv;
-  mv[kScalar] = r.w(), mv[kE23] = -r.x(), mv[kE13] = r.y(), mv[kE12] = -r.z();
-  mv[kE123inf] = -d.w(), mv[kE1inf] = -d.x(), mv[kE2inf] = -d.y(), mv[kE3inf] = -d.z();
-  return Motor<T>::from_multivector(mv);
+  Motor<T> m;
+  m.s = r.w(), m.e23 = -r.x(), m.e13 = r.y(), m.e12 = -r.z();
+  m.e123inf = -d.w(), m.e1inf = -d.x(), m.e2inf = -d.y(), m.e3inf = -d.z();
+  return m;
 }
 
 template <class T>
@@ -58,10 +58,14 @@ std::optional<Motor<T>> Motor<T>::from_matrix(const Eigen::Matrix<T, 4, 4>& m) {
 
 template <class T>
 Vec3<T> Motor<T>::translation() const {
-  // (0, t) = (−2 e123∞, −2 e∞-vector) ⊗ q̄ / |q|²  =  2 d q̄ / |q|².
-  const DualQuaternion<T> dq = to_dq(*this);
-  const Quat<T> t = Quat<T>(dq.dual.coeffs() * T(2)) * dq.real.conjugate();
-  return Vec3<T>(t.x(), t.y(), t.z()) / dq.real.squaredNorm();
+  // (0, t) = 2 d q̄ / |q|² with q = (w, v), d = (d0, dv) = (−e123∞, −e1∞, −e2∞, −e3∞):
+  //   t = 2 (w dv − d0 v + v × dv) / |q|².
+  const T w = s, vx = -e23, vy = e13, vz = -e12;
+  const T d0 = -e123inf, dx = -e1inf, dy = -e2inf, dz = -e3inf;
+  const T k = T(2) / (w * w + vx * vx + vy * vy + vz * vz);
+  return Vec3<T>(k * (w * dx - d0 * vx + vy * dz - vz * dy),
+                 k * (w * dy - d0 * vy + vz * dx - vx * dz),
+                 k * (w * dz - d0 * vz + vx * dy - vy * dx));
 }
 
 template <class T>
@@ -88,9 +92,23 @@ Multivector<T> Motor<T>::mv() const {
 
 template <class T>
 Motor<T> Motor<T>::compose(const Motor& a, const Motor& b) {
-  // (ra + ε da)(rb + ε db) = ra rb + ε (ra db + da rb).
-  const DualQuaternion<T> x = to_dq(a), y = to_dq(b);
-  return from_dq<T>(x.real * y.real, x.real * y.dual + x.dual * y.real);
+  // (ra + ε da)(rb + ε db) = ra rb + ε (ra db + da rb), with the Hamilton product
+  // (w1, v1)(w2, v2) = (w1 w2 − v1·v2, w1 v2 + w2 v1 + v1 × v2), written out on components.
+  const T aw = a.s, ax = -a.e23, ay = a.e13, az = -a.e12;
+  const T bw = b.s, bx = -b.e23, by = b.e13, bz = -b.e12;
+  const T pw = -a.e123inf, px = -a.e1inf, py = -a.e2inf, pz = -a.e3inf;  // da
+  const T qw = -b.e123inf, qx = -b.e1inf, qy = -b.e2inf, qz = -b.e3inf;  // db
+  Motor m;
+  m.s = aw * bw - ax * bx - ay * by - az * bz;
+  m.e23 = -(aw * bx + bw * ax + ay * bz - az * by);
+  m.e13 = aw * by + bw * ay + az * bx - ax * bz;
+  m.e12 = -(aw * bz + bw * az + ax * by - ay * bx);
+  const T dw = (aw * qw - ax * qx - ay * qy - az * qz) + (pw * bw - px * bx - py * by - pz * bz);
+  const T dx = (aw * qx + qw * ax + ay * qz - az * qy) + (pw * bx + bw * px + py * bz - pz * by);
+  const T dy = (aw * qy + qw * ay + az * qx - ax * qz) + (pw * by + bw * py + pz * bx - px * bz);
+  const T dz = (aw * qz + qw * az + ax * qy - ay * qx) + (pw * bz + bw * pz + px * by - py * bx);
+  m.e123inf = -dw, m.e1inf = -dx, m.e2inf = -dy, m.e3inf = -dz;
+  return m;
 }
 
 template <class T>

@@ -1,0 +1,75 @@
+// A console reporter that also prints, after the run, the ratio of each benchmark's median
+// (or mean, or single) real time to its baseline's, measured in the same process.
+//
+// Usage: register pairs with add_ratio("BM_Kernel/1024", "BM_Baseline/1024") and call
+// run_with_ratios(argc, argv) from main. With --benchmark_repetitions=N the medians are used.
+#pragma once
+
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace conform::bench {
+
+struct RatioPair {
+  std::string kernel, baseline, label;
+};
+
+inline std::vector<RatioPair>& ratio_pairs() {
+  static std::vector<RatioPair> pairs;
+  return pairs;
+}
+inline void add_ratio(std::string kernel, std::string baseline, std::string label = {}) {
+  ratio_pairs().push_back({std::move(kernel), std::move(baseline), std::move(label)});
+}
+
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const auto& run : runs) {
+      // Prefer the median aggregate when repetitions are used, else the single run.
+      const std::string name = run.run_name.str();
+      const double t = run.GetAdjustedRealTime();
+      if (run.run_type == Run::RT_Aggregate) {
+        if (run.aggregate_name == "median") medians_[name] = t;
+      } else if (!medians_.count(name) || singles_.count(name)) {
+        singles_[name] = t;
+        if (!medians_.count(name)) medians_[name] = t;
+      }
+    }
+  }
+  void Finalize() override {
+    ConsoleReporter::Finalize();
+    std::printf("\nRatios (kernel time / baseline time, same run; < 1 means faster):\n");
+    for (const auto& p : ratio_pairs()) {
+      auto k = medians_.find(p.kernel), b = medians_.find(p.baseline);
+      if (k == medians_.end() || b == medians_.end()) continue;
+      std::printf("  %-48s %-40s %7.3f\n", p.kernel.c_str(),
+                  (p.label.empty() ? "vs " + p.baseline : p.label).c_str(), k->second / b->second);
+    }
+    std::fflush(stdout);
+  }
+
+ private:
+  std::map<std::string, double> medians_, singles_;
+};
+
+inline int run_with_ratios(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+#if defined(CONFORM_NATIVE_BUILD) && CONFORM_NATIVE_BUILD
+  benchmark::AddCustomContext("conform_march_native", "on");
+#else
+  benchmark::AddCustomContext("conform_march_native", "off");
+#endif
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+  return 0;
+}
+
+}  // namespace conform::bench
