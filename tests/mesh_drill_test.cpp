@@ -1,0 +1,126 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <random>
+
+#include "conform/mesh/analysis.hpp"
+#include "conform/mesh/drill.hpp"
+#include "conform/mesh/primitives.hpp"
+#include "conform/mesh/procedural_arm.hpp"
+
+using namespace conform::mesh;
+
+namespace {
+
+void expect_valid(const SkinnedMesh& m, const std::string& what) {
+  const MeshReport r = check_mesh(m, 1e-14 * std::pow(bounding_diagonal(m), 2));
+  EXPECT_TRUE(r.indices_valid) << what;
+  EXPECT_EQ(r.tiny_faces, 0) << what;
+  EXPECT_TRUE(r.manifold()) << what << ": " << r.summary();
+  EXPECT_TRUE(r.oriented()) << what;
+  for (Eigen::Index v = 0; v < m.weights.cols(); ++v)
+    ASSERT_NEAR(m.weights.col(v).sum(), 1.0, 1e-12) << what;
+}
+
+}  // namespace
+
+TEST(Drill, SheetHoleAreaAndRimOnCylinder) {
+  for (const double r : {0.05, 0.1, 0.2}) {
+    SkinnedMesh m = make_sheet(40, 40);
+    const double a0 = surface_area(m);
+    const std::int32_t nv0 = m.vertex_count();
+    Adjacency adj(m);
+    const DrillTool tool{{0.013, -0.021, -0.5}, {0.013, -0.021, 0.5}, r};
+    const DrillResult d = drill(m, adj, tool);
+    ASSERT_EQ(d.holes, 1) << d.message;
+    const double hole = std::numbers::pi * r * r;
+    EXPECT_NEAR(a0 - surface_area(m), hole, 0.02 * hole)
+        << "r " << r << " refinements " << d.refinements;
+    EXPECT_NEAR(d.removed_area, a0 - surface_area(m), 1e-12);
+    // The rim points computed on edges lie on the cylinder.
+    const std::int32_t rim_start = m.vertex_count() - d.rim_vertices;
+    EXPECT_GE(d.rim_vertices, 24);
+    for (std::int32_t v = rim_start; v < m.vertex_count(); ++v)
+      EXPECT_NEAR(std::sqrt(axis_distance_squared(tool, m.current.col(v))), r, 1e-9);
+    EXPECT_GE(rim_start, nv0);
+    expect_valid(m, "sheet r " + std::to_string(r));
+    // One new boundary loop: the hole.
+    EXPECT_EQ(label_pieces(m).count, 1);
+    Adjacency fresh(m);
+    for (std::int32_t h = 0; h < 3 * m.face_count(); ++h) ASSERT_EQ(adj.twin(h), fresh.twin(h));
+  }
+}
+
+TEST(Drill, CoarseMeshIsRefined) {
+  SkinnedMesh m = make_sheet(4, 4);  // faces of 0.25: a 0.05 hole sits inside one face
+  Adjacency adj(m);
+  const DrillResult d = drill(m, adj, {{0.01, 0.02, 1}, {0.01, 0.02, -1}, 0.05});
+  ASSERT_EQ(d.holes, 1) << d.message;
+  EXPECT_GT(d.refinements, 0);
+  EXPECT_GE(d.rim_vertices, 24);
+  EXPECT_NEAR(d.removed_area, std::numbers::pi * 0.0025, 0.02 * std::numbers::pi * 0.0025);
+  expect_valid(m, "coarse sheet");
+}
+
+TEST(Drill, ThroughBothWallsOfAClosedMesh) {
+  SkinnedMesh m = make_icosphere(4);
+  Adjacency adj(m);
+  const DrillResult d = drill(m, adj, {{0.1, 0.05, 2}, {0.1, 0.05, -2}, 0.2});
+  EXPECT_EQ(d.holes, 2);
+  expect_valid(m, "icosphere");
+  const MeshReport r = check_mesh(m);
+  EXPECT_GT(r.boundary_edges, 0);
+  // A drill whose tip stops inside makes one hole.
+  SkinnedMesh m2 = make_icosphere(4);
+  Adjacency adj2(m2);
+  EXPECT_EQ(drill(m2, adj2, {{0, 0, 0}, {0, 0, 2}, 0.2}).holes, 1);
+  expect_valid(m2, "icosphere, one wall");
+}
+
+TEST(Drill, DegenerateInputs) {
+  SkinnedMesh m = make_sheet(10, 10);
+  const SkinnedMesh m0 = m;
+  Adjacency adj(m);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(drill(m, adj, {{0, 0, 1}, {0, 0, -1}, 0.0}), std::invalid_argument);
+  EXPECT_THROW(drill(m, adj, {{0, 0, 1}, {0, 0, -1}, -0.1}), std::invalid_argument);
+  EXPECT_THROW(drill(m, adj, {{0, 0, 1}, {0, 0, 1}, 0.1}), std::invalid_argument);
+  EXPECT_THROW(drill(m, adj, {{nan, 0, 1}, {0, 0, -1}, 0.1}), std::invalid_argument);
+  EXPECT_THROW(drill(m, adj, {{0, 0, 1}, {0, 0, -1}, nan}), std::invalid_argument);
+  // Not piercing: beside the sheet, or stopping short of it.
+  DrillResult d = drill(m, adj, {{3, 0, 1}, {3, 0, -1}, 0.1});
+  EXPECT_EQ(d.holes, 0);
+  EXPECT_TRUE(d.changes.empty());
+  d = drill(m, adj, {{0, 0, 0.5}, {0, 0, 1}, 0.1});
+  EXPECT_EQ(d.holes, 0);
+  EXPECT_EQ(m.faces, m0.faces);
+  // Along a vertex and through grid lines (axis through a vertex, radius = an edge's length).
+  d = drill(m, adj, {{0, 0, 1}, {0, 0, -1}, 0.1});
+  EXPECT_EQ(d.holes, 1);
+  expect_valid(m, "through a vertex");
+}
+
+TEST(Drill, PropertyRandomDrillsOnTheArm) {
+  const SkinnedMesh arm = make_arm(1).mesh;
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> u(0, 1);
+  int holes = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    SkinnedMesh m = arm;
+    Adjacency adj(m);
+    // A random direction through a random point of the arm's axis region.
+    const Eigen::Vector3d c(0.02 * (u(rng) - 0.5), 0.02 * (u(rng) - 0.5), 0.05 + 0.55 * u(rng));
+    Eigen::Vector3d dir(u(rng) - 0.5, u(rng) - 0.5, 0.6 * (u(rng) - 0.5));
+    dir.normalize();
+    const double r = 0.004 + 0.015 * u(rng);
+    const double reach = trial % 3 == 0 ? 0.0 : 0.2;  // a third stop at the centre: one wall
+    const DrillResult d = drill(m, adj, {c - reach * dir, c + 0.2 * dir, r});
+    holes += d.holes;
+    expect_valid(m, "arm trial " + std::to_string(trial));
+    EXPECT_EQ(label_pieces(m).count, 1) << trial;
+    if (testing::Test::HasFailure()) break;
+  }
+  EXPECT_GT(holes, 200);
+}
