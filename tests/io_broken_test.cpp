@@ -1,0 +1,97 @@
+// Bad model files give an ImportError naming the file and the problem, never a crash; the
+// `conform info` command exits non-zero on them.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
+#include "conform/io/import.hpp"
+
+namespace {
+
+using conform::io::ImportError;
+
+const std::string kBroken = std::string(CONFORM_TEST_DATA) + "/broken/";
+
+struct Broken {
+  const char* file;
+  const char* problem;  // a phrase the message must contain
+};
+
+class BrokenFile : public testing::TestWithParam<Broken> {};
+
+TEST_P(BrokenFile, ThrowsImportErrorNamingFileAndProblem) {
+  const Broken b = GetParam();
+  const std::string path = kBroken + b.file;
+  ASSERT_TRUE(std::filesystem::exists(path)) << path;
+  try {
+    conform::io::import_model(path);
+    FAIL() << "imported " << path;
+  } catch (const ImportError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(path, 0), 0u) << what;  // starts with the file name
+    EXPECT_EQ(e.file(), path);
+    EXPECT_NE(what.find(b.problem), std::string::npos) << what;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Files, BrokenFile,
+    testing::Values(Broken{"huesitos_truncated.fbx", "cannot be read"},
+                    Broken{"simple_skin_truncated.gltf", "cannot be read"},
+                    Broken{"anim_test_truncated.x", "end of file"},
+                    Broken{"notes_renamed.fbx", "cannot be read"},
+                    Broken{"notes_renamed.dae", "cannot be read"},
+                    Broken{"simple_skin_nan_key.gltf", "NaN or infinite rotation key 3"},
+                    Broken{"simple_skin_bad_weights.gltf", "sum to 0.700000, not 1"},
+                    Broken{"simple_skin_bad_joint.gltf", "sum to 0.250000, not 1"},
+                    Broken{"mesh.unknownformat", "unsupported format"}),
+    [](const auto& info) {
+      std::string n = info.param.file;
+      for (auto& c : n)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+      return n;
+    });
+
+TEST(IoBroken, MissingFileAndDirectory) {
+  try {
+    conform::io::import_model(kBroken + "does_not_exist.fbx");
+    FAIL();
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("does_not_exist.fbx: no such file"), std::string::npos);
+  }
+  try {
+    conform::io::load_model(kBroken);
+    FAIL();
+  } catch (const ImportError& e) {
+    EXPECT_NE(std::string(e.what()).find("directory"), std::string::npos);
+  }
+}
+
+TEST(IoBroken, OriginalsOfTheBrokenCopiesImport) {
+  // The broken files are broken by their edits, not because the originals are.
+  const std::string models = CONFORM_ASSIMP_MODELS;
+  EXPECT_NO_THROW(conform::io::import_model(models + "/FBX/huesitos.fbx"));
+  EXPECT_NO_THROW(conform::io::import_model(models + "/glTF2/simple_skin/simple_skin.gltf"));
+  EXPECT_NO_THROW(conform::io::import_model(models + "/X/anim_test.x"));
+}
+
+// The command: non-zero exit and the message on stderr. Needs the `conform` binary of this
+// build tree.
+TEST(IoBroken, InfoCommandExitsNonZero) {
+  const std::string conform = std::string(CONFORM_BINARY_DIR) + "/scenes/conform";
+  if (!std::filesystem::exists(conform)) GTEST_SKIP() << "conform not built";
+  const std::string out = ::testing::TempDir() + "io_broken_info.txt";
+  for (const char* f : {"notes_renamed.fbx", "simple_skin_nan_key.gltf"}) {
+    const std::string cmd = conform + " info " + kBroken + f + " > /dev/null 2> " + out;
+    const int rc = std::system(cmd.c_str());
+    EXPECT_NE(rc, 0) << f;
+    std::ifstream in(out);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find(f), std::string::npos) << text;
+  }
+  EXPECT_EQ(std::system((conform + " info arm > /dev/null").c_str()), 0);
+}
+
+}  // namespace
