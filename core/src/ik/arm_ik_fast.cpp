@@ -80,7 +80,7 @@ Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, T swivel) {
   }
   const auto c = constants(arm);
   const auto run = [&](T phi) {
-    return detail::solve_kernel(c, target.x(), target.y(), target.z(), phi);
+    return detail::solve_kernel<T, false>(c, target.x(), target.y(), target.z(), phi);
   };
   if (!arm.limits.has_cone()) return to_solution(run(swivel));
 
@@ -194,14 +194,13 @@ bool BatchSolveJob<T>::Run() const {
     run_range(c, p, 0, n);
     return true;
   }
-#pragma omp parallel num_threads(team)
-  {
-    const std::ptrdiff_t nt = omp_get_num_threads(), t = omp_get_thread_num();
-    // Contiguous chunks, multiples of 64 elements so that threads never share a cache line.
-    const std::ptrdiff_t chunk = ((n + nt - 1) / nt + 63) / 64 * 64;
-    const std::ptrdiff_t begin = std::min(n, t * chunk), end = std::min(n, begin + chunk);
-    if (begin < end) run_range(c, p, begin, end);
-  }
+  // Blocks handed out dynamically: on a shared machine a thread that loses its core for a
+  // while does not hold the whole batch back (its blocks go to the other thread).
+  constexpr std::ptrdiff_t kBlock = 4096;  // a multiple of 64: no shared cache lines
+  const std::ptrdiff_t blocks = (n + kBlock - 1) / kBlock;
+#pragma omp parallel for num_threads(team) schedule(dynamic, 1)
+  for (std::ptrdiff_t b = 0; b < blocks; ++b)
+    run_range(c, p, b * kBlock, std::min(n, (b + 1) * kBlock));
   return true;
 }
 

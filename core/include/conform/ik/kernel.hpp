@@ -142,13 +142,14 @@ struct KernelConstants {
     c.d1 = T(d1), c.d2 = T(d2);
     c.geo_max = T(d1 + d2), c.geo_min = T(std::abs(d1 - d2));
     // |Pw| as a function of the flexion: L(θ)² = d1² + d2² + 2 d1 d2 cos θ.
-    const double lmax =
-        std::sqrt(std::max(0.0, d1 * d1 + d2 * d2 + 2 * d1 * d2 * std::cos(flex_min)));
-    const double lmin =
-        std::sqrt(std::max(0.0, d1 * d1 + d2 * d2 + 2 * d1 * d2 * std::cos(flex_max)));
+    const auto reach = [&](double flex) {
+      return std::sqrt(std::max(0.0, d1 * d1 + d2 * d2 + 2 * d1 * d2 * std::cos(flex)));
+    };
+    const double lmax = flex_min > 0 ? reach(flex_min) : d1 + d2;
+    const double lmin = flex_max < std::numbers::pi ? reach(flex_max) : std::abs(d1 - d2);
     const double tiny = 64 * std::numeric_limits<T>::epsilon() * (d1 + d2);
     c.reach_max = flex_min > 0 ? T(lmax) : c.geo_max;
-    c.reach_min = T(std::max(flex_max < std::numbers::pi ? lmin : std::abs(d1 - d2), tiny));
+    c.reach_min = T(std::max(lmin, tiny));
     c.d1_minus_d2 = T(d1 - d2);
     c.dd = T((d1 - d2) * (d1 + d2));
     c.k_half = T(0.5 / std::sqrt(d1 * d2));
@@ -185,9 +186,25 @@ struct KernelResult {
 inline constexpr std::uint8_t kBitOuter = 1, kBitInner = 2, kBitShoulder = 4, kBitTargetAxis = 8,
                               kBitElbowAxis = 16, kBitElbowLimit = 32, kBitInvalid = 128;
 
-template <class T>
+/// kVector: roots by rsqrt() (vectorizes); otherwise by std::sqrt and division, whose latency
+/// is shorter for one solve at a time (the results agree to an ulp or two).
+template <class T, bool kVector = true>
 [[gnu::always_inline]] inline KernelResult<T> solve_kernel(const KernelConstants<T>& c, T px, T py,
                                                            T pz, T phi) {
+  const auto rsqrt = [](T x) {
+    if constexpr (kVector) {
+      return detail::rsqrt(x);
+    } else {
+      return T(1) / std::sqrt(x);
+    }
+  };
+  const auto sqrt = [](T x) {
+    if constexpr (kVector) {
+      return detail::sqrt(x);
+    } else {
+      return std::sqrt(x);
+    }
+  };
   // Invalid input (NaN, ±inf, |P|² overflow, huge φ): solve a harmless target, report it.
   const T r2_in = px * px + py * py + pz * pz;
   // Bitwise & and | on the conditions (not && ||): no branches for the vectorizer.
