@@ -1,23 +1,48 @@
 #!/usr/bin/env bash
-# Builds everything and runs the whole test suite with ctest. Under CI (CI=true) warnings are
-# errors, and the core tests are run once more in an ASan+UBSan build (skip with
-# CONFORM_SKIP_SANITIZE=1; force it locally with CONFORM_SANITIZE_TESTS=1).
+# Builds everything and runs the whole test suite with ctest.
+#
+# Under CI (CI=true), or when asked locally, two more configurations run after the main one:
+#   - ASan+UBSan build of the core tests (cga_*, ik_*)     CONFORM_SANITIZE_TESTS=1 / CONFORM_SKIP_SANITIZE=1
+#   - Debian's double-precision Bullet: plugin tests and   CONFORM_DOUBLE_TESTS=1   / CONFORM_SKIP_DOUBLE=1
+#     the find_package install test (-DCONFORM_DOUBLE=ON)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${CONFORM_BUILD_DIR:-$root/build}"
-"$root/scripts/build.sh"
-ctest --test-dir "$build" --output-on-failure --parallel "$(nproc)" --timeout 600
+jobs="$(nproc)"
+ci="${CI:-false}"
 
-if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "${CI:-}" == "true" || "${CONFORM_SANITIZE_TESTS:-0}" == "1" ) ]]; then
-  echo "conform: ASan+UBSan build of the core tests"
-  san="$build-sanitize"
-  generator=()
-  if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
-  cmake -S "$root" -B "$san" "${generator[@]}" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    -DCONFORM_SANITIZE=ON -DCONFORM_BUILD_BENCHMARKS=OFF >/dev/null
-  mapfile -t core_tests < <(cd "$root/tests" && ls cga_*_test.cpp ik_*_test.cpp 2>/dev/null | sed 's/\.cpp$//')
-  cmake --build "$san" --parallel "$(nproc)" --target "${core_tests[@]}"
+"$root/scripts/build.sh"
+ctest --test-dir "$build" --output-on-failure --parallel "$jobs" --timeout 900
+
+generator=()
+if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
+werror=OFF
+if [[ "$ci" == "true" ]]; then werror=ON; fi
+
+# Builds the given test targets in a second configuration and runs the tests matching a regex.
+extra_configuration() {
+  local dir="$1" regex="$2" pattern="$3"
+  shift 3
+  local log
+  log="$(mktemp)"
+  cmake -S "$root" -B "$dir" "${generator[@]}" -DCONFORM_BUILD_BENCHMARKS=OFF \
+    -DCONFORM_WERROR="$werror" "$@" >"$log" 2>&1 || { cat "$log"; return 1; }
+  local targets
+  mapfile -t targets < <(cd "$root/tests" && ls $pattern 2>/dev/null | sed 's/\.cpp$//')
+  cmake --build "$dir" --parallel "$jobs" --target conform "${targets[@]}"
+  ctest --test-dir "$dir" --output-on-failure --parallel "$jobs" --timeout 900 \
+    -R "$regex" -E NOT_BUILT
+}
+
+if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SANITIZE_TESTS:-0}" == "1" ) ]]; then
+  echo "conform: core tests under ASan+UBSan"
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    ctest --test-dir "$san" --output-on-failure --parallel "$(nproc)" --timeout 900 \
-      -R '^(cga_|ik_)' -E NOT_BUILT
+    extra_configuration "$build-sanitize" '^(cga_|ik_)' 'cga_*_test.cpp ik_*_test.cpp' \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCONFORM_SANITIZE=ON
+fi
+
+if [[ "${CONFORM_SKIP_DOUBLE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_DOUBLE_TESTS:-0}" == "1" ) ]]; then
+  echo "conform: plugin tests against double-precision Bullet"
+  extra_configuration "$build-double" '^(plugin_|install_test)' 'plugin_*_test.cpp' \
+    -DCMAKE_BUILD_TYPE=Release -DCONFORM_DOUBLE=ON
 fi
