@@ -1,8 +1,258 @@
+// `conform cut`, `conform tear` and `conform drill`: load a model (a file or arm[:N]), apply
+// the operation to its current (bind-pose, world-space) positions, and write every resulting
+// piece as PLY (or OBJ) into DIR with a summary.json of counts and timings.
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
 #include "commands.hpp"
+#include "conform/io/import.hpp"
+#include "conform/io/mesh_export.hpp"
+#include "conform/mesh/analysis.hpp"
+#include "conform/mesh/cut.hpp"
+#include "conform/mesh/drill.hpp"
+#include "conform/mesh/tear.hpp"
 
 namespace conform::cli {
 
-// Placeholder registration: the subcommand is added by its issue's work.
-void register_mesh_ops(CLI::App&, Context&) {}
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+struct Common {
+  std::string model;
+  std::string out;
+  std::string format = "ply";
+};
+
+void add_common(CLI::App* cmd, Common& c) {
+  cmd->add_option("MODEL", c.model, "model file (any format assimp reads) or arm[:N]")->required();
+  cmd->add_option("--out", c.out, "output directory (created if missing)")->required();
+  cmd->add_option("--format", c.format, "ply (binary), ply-ascii or obj")
+      ->check(CLI::IsMember({"ply", "ply-ascii", "obj"}));
+}
+
+// Loads the model; returns its mesh (current = the bind pose in world space).
+mesh::SkinnedMesh load(const Common& c, nlohmann::json& summary) {
+  const auto t0 = Clock::now();
+  io::SkinnedModel model = io::load_model(c.model);
+  summary["model"] = model.source;
+  summary["input"] = {{"vertices", model.mesh.vertex_count()}, {"faces", model.mesh.face_count()}};
+  summary["timing_ms"]["load"] = ms_since(t0);
+  return std::move(model.mesh);
+}
+
+// Writes every piece and summary.json; only these files are written into the directory.
+void write_pieces(const Common& c, const mesh::SkinnedMesh& m, nlohmann::json& summary) {
+  const auto t0 = Clock::now();
+  const fs::path dir(c.out);
+  fs::create_directories(dir);
+  const io::MeshFormat format = io::parse_mesh_format(c.format);
+  const mesh::Pieces pieces = mesh::label_pieces(m);
+  std::vector<std::vector<std::int32_t>> faces(static_cast<std::size_t>(pieces.count));
+  for (std::size_t f = 0; f < pieces.face_piece.size(); ++f)
+    faces[static_cast<std::size_t>(pieces.face_piece[f])].push_back(static_cast<std::int32_t>(f));
+  nlohmann::json list = nlohmann::json::array();
+  for (std::int32_t p = 0; p < pieces.count; ++p) {
+    char name[32];
+    std::snprintf(name, sizeof name, "piece_%03d%s", p, io::mesh_format_extension(format));
+    const auto& pf = faces[static_cast<std::size_t>(p)];
+    io::write_mesh(dir / name, m, {format, false, true}, pf);
+    std::vector<char> used(static_cast<std::size_t>(m.vertex_count()), 0);
+    std::int32_t nv = 0;
+    for (auto f : pf)
+      for (auto v : m.faces[static_cast<std::size_t>(f)])
+        nv += used[static_cast<std::size_t>(v)] ? 0 : (used[static_cast<std::size_t>(v)] = 1);
+    list.push_back({{"file", name},
+                    {"vertices", nv},
+                    {"faces", pf.size()},
+                    {"area", mesh::surface_area(m, pf)}});
+  }
+  const mesh::MeshReport report = mesh::check_mesh(m);
+  summary["output"] = {{"vertices", m.vertex_count()}, {"faces", m.face_count()},
+                       {"pieces", pieces.count},       {"piece_files", list},
+                       {"closed", report.closed()},    {"manifold", report.manifold()},
+                       {"oriented", report.oriented()}};
+  summary["timing_ms"]["write"] = ms_since(t0);
+  std::ofstream os(dir / "summary.json.tmp");
+  os << summary.dump(2) << "\n";
+  os.close();
+  if (!os) throw std::runtime_error("cannot write " + (dir / "summary.json").string());
+  fs::rename(dir / "summary.json.tmp", dir / "summary.json");
+}
+
+template <class Fn>
+void run(Context& context, const char* name, Fn fn) {
+  try {
+    fn();
+    context.exit_code = 0;
+  } catch (const std::exception& e) {
+    std::cerr << "conform " << name << ": " << e.what() << "\n";
+    context.exit_code = 1;
+  }
+}
+
+// Reads the scalpel CSV: header t,ax,ay,az,bx,by,bz, then one sample per line.
+std::vector<mesh::ScalpelSample> read_scalpel(const std::string& file) {
+  std::ifstream is(file);
+  if (!is) throw std::runtime_error("cannot open scalpel file " + file);
+  std::string line;
+  if (!std::getline(is, line)) throw std::runtime_error(file + ": empty scalpel file");
+  std::string header;
+  for (char ch : line)
+    if (!std::isspace(static_cast<unsigned char>(ch))) header += ch;
+  if (header != "t,ax,ay,az,bx,by,bz")
+    throw std::runtime_error(file + ": the header must be t,ax,ay,az,bx,by,bz");
+  std::vector<mesh::ScalpelSample> out;
+  int row = 1;
+  while (std::getline(is, line)) {
+    ++row;
+    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::stringstream ss(line);
+    double v[7];
+    for (int k = 0; k < 7; ++k) {
+      std::string cell;
+      if (!std::getline(ss, cell, ','))
+        throw std::runtime_error(file + ":" + std::to_string(row) + ": expected 7 values");
+      try {
+        std::size_t used = 0;
+        v[k] = std::stod(cell, &used);
+      } catch (const std::exception&) {
+        throw std::runtime_error(file + ":" + std::to_string(row) + ": not a number: '" + cell +
+                                 "'");
+      }
+    }
+    out.push_back({v[0], {v[1], v[2], v[3]}, {v[4], v[5], v[6]}});
+  }
+  return out;
+}
+
+}  // namespace
+
+void register_mesh_ops(CLI::App& app, Context& context) {
+  {
+    auto common = std::make_shared<Common>();
+    auto plane = std::make_shared<std::vector<double>>();
+    auto cap = std::make_shared<bool>(false);
+    auto* cmd =
+        app.add_subcommand("cut", "Cut a model by a plane (Algorithm 1) and write the pieces");
+    add_common(cmd, *common);
+    cmd->add_option("--plane", *plane, "unit normal and distance: NX NY NZ D (n·x = D)")
+        ->expected(4)
+        ->required();
+    cmd->add_flag("--cap", *cap, "close every cut loop with a triangulated cap");
+    cmd->callback([&context, common, plane, cap]() {
+      run(context, "cut", [&] {
+        nlohmann::json summary;
+        summary["command"] = "cut";
+        mesh::SkinnedMesh m = load(*common, summary);
+        const auto& p = *plane;
+        const auto t0 = Clock::now();
+        mesh::Adjacency adjacency(m);
+        const double t_adj = ms_since(t0);
+        const auto t1 = Clock::now();
+        const mesh::CutOutcome out = mesh::cut(
+            m, adjacency, cga::Plane<double>::from_normal_distance({p[0], p[1], p[2]}, p[3]),
+            {.cap = *cap});
+        summary["timing_ms"]["adjacency"] = t_adj;
+        summary["timing_ms"]["operation"] = ms_since(t1);
+        summary["status"] = out.result.status == mesh::CutStatus::Cut ? "cut" : "missed";
+        summary["crossed_edges"] = out.result.crossed_edges;
+        summary["snapped_vertices"] = out.result.snapped_vertices;
+        summary["new_vertices"] = out.result.change.new_vertices.size();
+        if (*cap)
+          summary["cap"] = {{"loops", out.result.loops},
+                            {"capped", out.result.capped_loops},
+                            {"faces_per_side", out.result.cap_faces}};
+        if (!out.result.message.empty()) summary["message"] = out.result.message;
+        if (out.result.status != mesh::CutStatus::Cut)
+          std::cerr << "conform cut: " << out.result.message << " (no-op)\n";
+        write_pieces(*common, m, summary);
+      });
+    });
+  }
+  {
+    auto common = std::make_shared<Common>();
+    auto scalpel = std::make_shared<std::string>();
+    auto open = std::make_shared<double>(0.0);
+    auto* cmd = app.add_subcommand("tear", "Tear a model along a scalpel path (Algorithm 2)");
+    add_common(cmd, *common);
+    cmd->add_option("--scalpel", *scalpel, "CSV with header t,ax,ay,az,bx,by,bz")->required();
+    cmd->add_option("--open", *open, "move the tear's two borders apart by this much (m)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->callback([&context, common, scalpel, open]() {
+      run(context, "tear", [&] {
+        nlohmann::json summary;
+        summary["command"] = "tear";
+        const auto samples = read_scalpel(*scalpel);
+        mesh::SkinnedMesh m = load(*common, summary);
+        const auto t0 = Clock::now();
+        mesh::Adjacency adjacency(m);
+        const double t_adj = ms_since(t0);
+        const auto t1 = Clock::now();
+        mesh::Tear tear(m, adjacency);
+        for (const auto& s : samples) tear.advance(s);
+        if (*open > 0) tear.open(*open);
+        summary["timing_ms"]["adjacency"] = t_adj;
+        summary["timing_ms"]["operation"] = ms_since(t1);
+        summary["samples"] = samples.size();
+        summary["tear"] = {
+            {"steps", tear.steps()}, {"points", tear.path_length()}, {"length", tear.length()}};
+        if (!tear.message().empty()) summary["message"] = tear.message();
+        if (tear.steps() == 0)
+          throw std::runtime_error("the scalpel never tore the surface: " + tear.message());
+        write_pieces(*common, m, summary);
+      });
+    });
+  }
+  {
+    auto common = std::make_shared<Common>();
+    auto tip = std::make_shared<std::vector<double>>();
+    auto base = std::make_shared<std::vector<double>>();
+    auto radius = std::make_shared<double>(0.0);
+    auto* cmd = app.add_subcommand("drill", "Drill a cylindrical hole (Algorithm 3)");
+    add_common(cmd, *common);
+    cmd->add_option("--tip", *tip, "drill tip A: X Y Z")->expected(3)->required();
+    cmd->add_option("--base", *base, "drill base B: X Y Z")->expected(3)->required();
+    cmd->add_option("--radius", *radius, "drill radius (m)")->required();
+    cmd->callback([&context, common, tip, base, radius]() {
+      run(context, "drill", [&] {
+        nlohmann::json summary;
+        summary["command"] = "drill";
+        mesh::SkinnedMesh m = load(*common, summary);
+        const auto& a = *tip;
+        const auto& b = *base;
+        const auto t0 = Clock::now();
+        mesh::Adjacency adjacency(m);
+        const double t_adj = ms_since(t0);
+        const auto t1 = Clock::now();
+        const mesh::DrillResult r =
+            mesh::drill(m, adjacency, {{a[0], a[1], a[2]}, {b[0], b[1], b[2]}, *radius});
+        summary["timing_ms"]["adjacency"] = t_adj;
+        summary["timing_ms"]["operation"] = ms_since(t1);
+        summary["holes"] = r.holes;
+        summary["rim_vertices"] = r.rim_vertices;
+        summary["removed_faces"] = r.removed_area_faces;
+        summary["removed_area"] = r.removed_area;
+        summary["refinements"] = r.refinements;
+        if (!r.message.empty()) summary["message"] = r.message;
+        if (r.holes == 0)
+          throw std::runtime_error("the drill does not pierce the surface: " + r.message);
+        write_pieces(*common, m, summary);
+      });
+    });
+  }
+}
 
 }  // namespace conform::cli

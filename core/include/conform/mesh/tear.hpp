@@ -1,0 +1,91 @@
+// Progressive tearing (Algorithm 2 of the second paper), on the current positions.
+//
+// The scalpel is a blade segment (a, b) sampled at times t_i. The first sample that meets the
+// surface starts the tear: its intersection S_0 is found by one scan of the faces and
+// inserted as a vertex. Every later sample i + 1:
+//   1. builds the plane Π through the tip S_i and the blade's end points at t_i+1;
+//   2. walks across faces from S_i along Π ∩ M (never scanning), in the direction of the
+//      blade, until it reaches the face the blade crosses: that point is S_i+1, and the edge
+//      crossings on the way are the Q_j (an edge crossing within snap_fraction of an end is
+//      taken at that vertex, so there are no slivers);
+//   3. splits the crossed faces along S_i, Q_1 … Q_m, S_i+1 (new vertices on edges, S_i+1
+//      inside its face), then duplicates every interior point of the path (the old tip S_i,
+//      the Q_j) for the faces on the path's left, so the tear opens there; S_i+1 is the new
+//      tip. Successive samples thus extend one continuous tear.
+// Every step is one or two TopologyChanges (insert, then separate), applied at once and
+// returned so a soft body can mirror them. New vertices carry weights, UVs and normals as
+// described in topology_change.hpp.
+//
+// Degenerate input: non-finite samples throw std::invalid_argument; a blade outside the
+// mesh, a blade that has not moved, a blade collinear with the tip, or a walk that reaches a
+// boundary or the step limit leave the mesh unchanged for that sample (see message()).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "conform/mesh/adjacency.hpp"
+#include "conform/mesh/topology_change.hpp"
+
+namespace conform::mesh {
+
+struct ScalpelSample {
+  double t = 0;
+  Eigen::Vector3d a = Eigen::Vector3d::Zero(), b = Eigen::Vector3d::Zero();  // blade end points
+};
+
+struct TearOptions {
+  double snap_fraction = 0.05;  // of an edge (and barycentric margin of the tip in its face)
+  int max_walk_faces = 100000;  // bound of one step's walk
+};
+
+struct TearStep {
+  std::vector<TopologyChange> changes;  // already applied, in order
+  bool extended = false;                // the tear grew
+};
+
+class Tear {
+ public:
+  /// The mesh and adjacency must outlive the Tear; every change is applied to both.
+  Tear(SkinnedMesh& mesh, Adjacency& adjacency, const TearOptions& options = {});
+
+  TearStep advance(const ScalpelSample& sample);
+  /// Step 6: moves the two copies of each interior tear point apart along ± the normal of
+  /// the plane Π that made it, by `amount` in total at the middle of the tear, tapering
+  /// (sin) to zero at both ends. Changes current positions only; returns the displacements
+  /// (vertex, offset) it applied.
+  std::vector<std::pair<std::int32_t, Eigen::Vector3d>> open(double amount);
+
+  bool started() const { return tip_ >= 0; }
+  int steps() const { return steps_; }
+  /// Points of the tear (start, interior points, tip).
+  std::int32_t path_length() const { return static_cast<std::int32_t>(path_.size()); }
+  /// The tear's length along its path (current positions of the right border).
+  double length() const;
+  /// The two borders as vertex chains from the start to the tip (they share both ends).
+  std::vector<std::int32_t> left_border() const;
+  std::vector<std::int32_t> right_border() const;
+  const std::string& message() const { return message_; }
+
+ private:
+  struct PathVertex {
+    std::int32_t right = -1;  // the original vertex (faces right of the path)
+    std::int32_t left = -1;   // its duplicate for the faces on the left, −1 at the ends
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // Π's unit normal of the step
+  };
+  bool start(const ScalpelSample& sample, TearStep& step);
+
+  SkinnedMesh& mesh_;
+  Adjacency& adjacency_;
+  TearOptions options_;
+  std::vector<PathVertex> path_;
+  std::int32_t tip_ = -1;
+  std::int32_t tip_neighbor_ = -1;  // a vertex sharing an edge with the tip
+  int steps_ = 0;
+  std::string message_;
+};
+
+}  // namespace conform::mesh

@@ -1,0 +1,543 @@
+#include "conform/mesh/tear.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <stdexcept>
+
+#include "conform/cga/plane.hpp"
+#include "conform/mesh/analysis.hpp"
+
+namespace conform::mesh {
+
+namespace {
+
+// A point of the tear's path: a vertex, a point on an edge, or a point inside a face.
+struct PathPoint {
+  enum Kind { Vertex, Edge, Inside } kind = Vertex;
+  std::int32_t v = -1;          // Vertex
+  std::int32_t a = -1, b = -1;  // Edge: (1 − t) a + t b
+  double t = 0;
+  std::array<double, 3> bary{0, 0, 0};  // Inside: barycentric in the crossing's face
+};
+
+struct Crossing {
+  std::int32_t face;
+  PathPoint in, out;
+};
+
+// Segment p→q against triangle (a, b, c); on a hit, the barycentric coordinates of the hit.
+bool segment_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
+                      const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                      std::array<double, 3>& bary) {
+  const Eigen::Vector3d d = q - p, e1 = b - a, e2 = c - a;
+  const Eigen::Vector3d h = d.cross(e2);
+  const double det = e1.dot(h);
+  if (!(std::abs(det) > 1e-300)) return false;
+  const double inv = 1 / det;
+  const Eigen::Vector3d s = p - a;
+  const double u = inv * s.dot(h);
+  if (u < 0 || u > 1) return false;
+  const Eigen::Vector3d qv = s.cross(e1);
+  const double v = inv * d.dot(qv);
+  if (v < 0 || u + v > 1) return false;
+  const double t = inv * e2.dot(qv);
+  if (t < 0 || t > 1) return false;
+  bary = {1 - u - v, u, v};
+  return true;
+}
+
+// The faces around vertex v, starting from half-edge h out of v (CCW, then CW from h if a
+// boundary stops the first sweep).
+std::vector<std::int32_t> fan(const Adjacency& adj, std::int32_t h) {
+  std::vector<std::int32_t> out;
+  std::int32_t g = h;
+  for (int guard = 0; guard < 4096; ++guard) {
+    out.push_back(g);
+    const std::int32_t prev = 3 * (g / 3) + (g % 3 + 2) % 3;
+    const std::int32_t o = adj.twin(prev);
+    if (o < 0) break;
+    if (o == h) return out;
+    g = o;
+  }
+  // Open fan: the other way from h.
+  g = h;
+  for (int guard = 0; guard < 4096; ++guard) {
+    const std::int32_t o = adj.twin(g);
+    if (o < 0) break;
+    g = 3 * (o / 3) + (o % 3 + 1) % 3;
+    if (g == h) break;
+    out.push_back(g);
+  }
+  return out;
+}
+
+}  // namespace
+
+Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, const TearOptions& options)
+    : mesh_(mesh), adjacency_(adjacency), options_(options) {
+  if (!adjacency.matches(mesh))
+    throw std::invalid_argument("tear: the adjacency does not describe this mesh");
+  if (!(options.snap_fraction > 0 && options.snap_fraction < 0.25))
+    throw std::invalid_argument("tear: snap_fraction must be in (0, 0.25)");
+}
+
+bool Tear::start(const ScalpelSample& s, TearStep& step) {
+  std::array<double, 3> bary{};
+  std::int32_t hit = -1;
+  for (std::int32_t f = 0; f < mesh_.face_count() && hit < 0; ++f) {
+    const Face& t = mesh_.faces[static_cast<std::size_t>(f)];
+    if (segment_triangle(s.a, s.b, mesh_.current.col(t[0]), mesh_.current.col(t[1]),
+                         mesh_.current.col(t[2]), bary))
+      hit = f;
+  }
+  if (hit < 0) {
+    message_ = "the scalpel does not meet the surface";
+    return false;
+  }
+  // Keep the start point off the face's edges (no slivers).
+  const double m = options_.snap_fraction;
+  for (auto& x : bary) x = std::max(x, m);
+  const double sum = bary[0] + bary[1] + bary[2];
+  for (auto& x : bary) x /= sum;
+  const Face f = mesh_.faces[static_cast<std::size_t>(hit)];
+  TopologyChange ch;
+  ch.base_vertex_count = mesh_.vertex_count();
+  ch.base_face_count = mesh_.face_count();
+  const std::int32_t s0 = mesh_.vertex_count();
+  ch.new_vertices.push_back(NewVertex::in_face(f[0], f[1], f[2], bary[0], bary[1], bary[2]));
+  ch.removed_faces = {hit};
+  ch.added_faces = {{f[0], f[1], s0}, {f[1], f[2], s0}, {f[2], f[0], s0}};
+  apply(mesh_, ch, &adjacency_);
+  step.changes.push_back(std::move(ch));
+  tip_ = s0;
+  tip_neighbor_ = f[0];
+  path_.push_back({s0, -1, Eigen::Vector3d::Zero()});
+  message_.clear();
+  return true;
+}
+
+TearStep Tear::advance(const ScalpelSample& s) {
+  if (!std::isfinite(s.t) || !s.a.allFinite() || !s.b.allFinite())
+    throw std::invalid_argument("tear: non-finite scalpel sample");
+  TearStep step;
+  if (tip_ < 0) {
+    start(s, step);
+    return step;
+  }
+  const Eigen::Vector3d tip = mesh_.current.col(tip_);
+  const auto plane = cga::Plane<double>::through(tip, s.a, s.b);
+  if (!plane) {
+    message_ = "the blade is collinear with the tip: no plane";
+    return step;
+  }
+  const Eigen::Vector3d n = plane->normal();
+  const double scale = std::max({(s.a - tip).norm(), (s.b - tip).norm(), 1e-300});
+  const double zero = 1e-12 * scale;
+  auto delta = [&](std::int32_t v) {
+    const double d = plane->signed_distance(mesh_.current.col(v));
+    return std::abs(d) <= zero ? 0.0 : d;
+  };
+  const double snap = options_.snap_fraction;
+  auto pos = [&](const PathPoint& p, std::int32_t face) -> Eigen::Vector3d {
+    if (p.kind == PathPoint::Vertex) return mesh_.current.col(p.v);
+    if (p.kind == PathPoint::Edge)
+      return (1 - p.t) * mesh_.current.col(p.a) + p.t * mesh_.current.col(p.b);
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    return p.bary[0] * mesh_.current.col(f[0]) + p.bary[1] * mesh_.current.col(f[1]) +
+           p.bary[2] * mesh_.current.col(f[2]);
+  };
+  auto blade_hit = [&](std::int32_t face, PathPoint& out) {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    std::array<double, 3> bary{};
+    if (!segment_triangle(s.a, s.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
+                          mesh_.current.col(f[2]), bary))
+      return false;
+    for (auto& x : bary) x = std::max(x, snap);
+    const double sum = bary[0] + bary[1] + bary[2];
+    for (auto& x : bary) x /= sum;
+    out.kind = PathPoint::Inside;
+    out.bary = bary;
+    return true;
+  };
+  // Where Π leaves face `face` through the edge opposite its corner `corner` (x = next,
+  // y = after): a vertex, or a point on the edge; false when Π does not cross that edge.
+  auto exit_opposite = [&](std::int32_t face, int corner, bool snap_x, bool snap_y,
+                           PathPoint& out) {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    const std::int32_t x = f[(corner + 1) % 3], y = f[(corner + 2) % 3];
+    const double dx = delta(x), dy = delta(y);
+    if (dx == 0 && snap_x) return out = {PathPoint::Vertex, x}, true;
+    if (dy == 0 && snap_y) return out = {PathPoint::Vertex, y}, true;
+    if (!(dx * dy < 0)) return false;
+    double t = dx / (dx - dy);
+    if (t < snap) {
+      if (snap_x) return out = {PathPoint::Vertex, x}, true;
+      t = snap;
+    } else if (t > 1 - snap) {
+      if (snap_y) return out = {PathPoint::Vertex, y}, true;
+      t = 1 - snap;
+    }
+    out = {PathPoint::Edge, -1, x, y, t};
+    return true;
+  };
+  // The blade's point nearest the tip gives the direction to walk in.
+  const Eigen::Vector3d ab = s.b - s.a;
+  const double u = std::clamp((tip - s.a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+  const Eigen::Vector3d toward = s.a + u * ab - tip;
+
+  // Candidate first moves from a vertex: (face, corner of the vertex, exit, cosine).
+  struct Move {
+    std::int32_t face;
+    PathPoint out;
+    double cosine;
+  };
+  auto moves_from = [&](std::int32_t v, std::int32_t any_neighbor, const Eigen::Vector3d& dir,
+                        std::vector<std::int32_t>& fan_faces) {
+    std::vector<Move> moves;
+    std::int32_t h = adjacency_.find(v, any_neighbor);
+    if (h < 0) {
+      const std::int32_t g = adjacency_.find(any_neighbor, v);
+      if (g < 0) return moves;
+      h = 3 * (g / 3) + (g % 3 + 1) % 3;
+    }
+    fan_faces.clear();
+    for (auto he : fan(adjacency_, h)) {
+      const std::int32_t face = he / 3;
+      fan_faces.push_back(face);
+      PathPoint out;
+      if (!exit_opposite(face, he % 3, true, true, out)) continue;
+      const Eigen::Vector3d e = pos(out, face) - mesh_.current.col(v);
+      const double len = e.norm() * dir.norm();
+      moves.push_back({face, out, len > 0 ? e.dot(dir) / len : -1});
+    }
+    std::sort(moves.begin(), moves.end(),
+              [](const Move& a, const Move& b) { return a.cosine > b.cosine; });
+    return moves;
+  };
+  auto corner_of = [&](std::int32_t face, std::int32_t v) {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    return f[0] == v ? 0 : (f[1] == v ? 1 : 2);
+  };
+
+  // Walk from the tip; the first candidate direction that reaches the blade wins.
+  std::vector<Crossing> path;
+  std::int32_t neighbor = -1;
+  {
+    // Any neighbour of the tip: the vertices of a face holding it, found through the last
+    // path point or the start face.
+    neighbor = path_.size() >= 2 ? path_[path_.size() - 2].right : -1;
+    if (neighbor < 0 ||
+        (adjacency_.find(tip_, neighbor) < 0 && adjacency_.find(neighbor, tip_) < 0))
+      neighbor = tip_neighbor_;
+  }
+  std::vector<std::int32_t> fan_faces;
+  std::vector<Move> first = moves_from(tip_, neighbor, toward, fan_faces);
+  bool unmoved = false;
+  for (auto face : fan_faces) {
+    PathPoint hit;
+    if (!blade_hit(face, hit)) continue;
+    // The blade still meets the surface next to the tip: nothing to tear yet.
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    const double size = (mesh_.current.col(f[1]) - mesh_.current.col(f[0])).norm();
+    std::array<double, 3> raw{};
+    segment_triangle(s.a, s.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
+                     mesh_.current.col(f[2]), raw);
+    const Eigen::Vector3d at = raw[0] * mesh_.current.col(f[0]) + raw[1] * mesh_.current.col(f[1]) +
+                               raw[2] * mesh_.current.col(f[2]);
+    if ((at - tip).norm() <= snap * size) {
+      unmoved = true;
+    } else {
+      path.push_back({face, {PathPoint::Vertex, tip_}, hit});
+    }
+    break;
+  }
+  if (unmoved) {
+    message_ = "the blade has not moved away from the tip";
+    return step;
+  }
+  for (const Move& m : first) {
+    if (!path.empty()) break;
+    if (m.cosine <= 0) break;
+    std::vector<Crossing> trial{{m.face, {PathPoint::Vertex, tip_}, m.out}};
+    std::vector<std::int32_t> visited{m.face};
+    bool done = false;
+    for (int guard = 0; guard < options_.max_walk_faces && !done; ++guard) {
+      const Crossing& last = trial.back();
+      const PathPoint at = last.out;
+      if (at.kind == PathPoint::Edge) {
+        std::int32_t h = adjacency_.find(at.a, at.b);
+        if (h < 0 || h / 3 != last.face) h = adjacency_.find(at.b, at.a);
+        const std::int32_t o = h >= 0 ? adjacency_.twin(h) : -1;
+        if (o < 0) break;  // a boundary: this direction fails
+        const std::int32_t g = o / 3;
+        if (std::find(visited.begin(), visited.end(), g) != visited.end()) break;
+        visited.push_back(g);
+        PathPoint out;
+        if (blade_hit(g, out)) {
+          trial.push_back({g, at, out});
+          done = true;
+          break;
+        }
+        // Leave g through one of the edges at its third vertex z (not back through (a, b)).
+        const int cz = (o % 3 + 2) % 3;
+        const Face& fg = mesh_.faces[static_cast<std::size_t>(g)];
+        const std::int32_t z = fg[cz];
+        const double dz = delta(z);
+        const std::int32_t w = delta(at.a) * dz < 0 ? at.a : at.b;  // the end across Π from z
+        if (dz == 0) {
+          out = {PathPoint::Vertex, z};
+        } else {
+          const double dw = delta(w);
+          double t = dz / (dz - dw);  // from z towards w
+          if (t < snap) {
+            out = {PathPoint::Vertex, z};
+          } else {
+            t = std::min(t, 1 - snap);
+            out = {PathPoint::Edge, -1, z, w, t};
+          }
+        }
+        trial.push_back({g, at, out});
+      } else {
+        // Through a vertex: the blade may be in a face around it, else continue straight on.
+        const Eigen::Vector3d wpos = mesh_.current.col(at.v);
+        const Eigen::Vector3d dir = wpos - pos(last.in, last.face);
+        const Face& lf = mesh_.faces[static_cast<std::size_t>(last.face)];
+        const std::int32_t nb = lf[(corner_of(last.face, at.v) + 1) % 3];
+        std::vector<std::int32_t> around;
+        std::vector<Move> next = moves_from(at.v, nb, dir, around);
+        for (auto face : around) {
+          if (std::find(visited.begin(), visited.end(), face) != visited.end()) continue;
+          PathPoint hit;
+          if (blade_hit(face, hit)) {
+            trial.push_back({face, at, hit});
+            done = true;
+            break;
+          }
+        }
+        if (done) break;
+        bool moved = false;
+        for (const Move& mv : next) {
+          if (mv.cosine <= 0) break;
+          if (std::find(visited.begin(), visited.end(), mv.face) != visited.end()) continue;
+          visited.push_back(mv.face);
+          trial.push_back({mv.face, at, mv.out});
+          moved = true;
+          break;
+        }
+        if (!moved) break;
+      }
+    }
+    if (done) path = std::move(trial);
+  }
+  if (path.empty()) {
+    message_ =
+        "the walk from the tip did not reach the blade (outside the mesh, unmoved, or past a "
+        "boundary)";
+    return step;
+  }
+
+  // Phase A: split the crossed faces along the path.
+  TopologyChange a;
+  a.base_vertex_count = mesh_.vertex_count();
+  a.base_face_count = mesh_.face_count();
+  const std::int32_t nv0 = mesh_.vertex_count();
+  EdgeMap edge_ids;
+  std::int32_t tip_id = -1;
+  auto id_of = [&](const PathPoint& p, std::int32_t face) {
+    if (p.kind == PathPoint::Vertex) return p.v;
+    if (p.kind == PathPoint::Edge) {
+      const std::int32_t lo = std::min(p.a, p.b), hi = std::max(p.a, p.b);
+      std::int32_t id = edge_ids.find(lo, hi);
+      if (id < 0) {
+        id = nv0 + static_cast<std::int32_t>(a.new_vertices.size());
+        a.new_vertices.push_back(NewVertex::on_edge(p.a, p.b, p.t));
+        edge_ids.insert(lo, hi, id);
+      }
+      return id;
+    }
+    if (tip_id < 0) {
+      const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+      tip_id = nv0 + static_cast<std::int32_t>(a.new_vertices.size());
+      a.new_vertices.push_back(
+          NewVertex::in_face(f[0], f[1], f[2], p.bary[0], p.bary[1], p.bary[2]));
+    }
+    return tip_id;
+  };
+  auto position_of = [&](std::int32_t id) -> Eigen::Vector3d {
+    if (id < nv0) return mesh_.current.col(id);
+    const NewVertex& nv = a.new_vertices[static_cast<std::size_t>(id - nv0)];
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k)
+      if (nv.parents[k] >= 0) x += nv.coefficients[k] * mesh_.current.col(nv.parents[k]);
+    return x;
+  };
+  std::vector<std::int32_t> points{tip_};
+  for (const Crossing& c : path) {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
+    const std::int32_t in = id_of(c.in, c.face), out = id_of(c.out, c.face);
+    points.push_back(out);
+    // The face as a polygon with the path's edge points inserted.
+    std::vector<std::int32_t> poly;
+    for (int k = 0; k < 3; ++k) {
+      poly.push_back(f[k]);
+      for (const PathPoint* p : {&c.in, &c.out})
+        if (p->kind == PathPoint::Edge &&
+            ((p->a == f[k] && p->b == f[(k + 1) % 3]) || (p->b == f[k] && p->a == f[(k + 1) % 3])))
+          poly.push_back(id_of(*p, c.face));
+    }
+    a.removed_faces.push_back(c.face);
+    const auto m = poly.size();
+    if (c.out.kind == PathPoint::Inside) {
+      for (std::size_t i = 0; i < m; ++i)
+        a.added_faces.push_back({poly[i], poly[(i + 1) % m], out});
+      continue;
+    }
+    const auto i_in =
+        static_cast<std::size_t>(std::find(poly.begin(), poly.end(), in) - poly.begin());
+    const auto i_out =
+        static_cast<std::size_t>(std::find(poly.begin(), poly.end(), out) - poly.begin());
+    if ((i_in + 1) % m == i_out || (i_out + 1) % m == i_in) {
+      a.removed_faces.pop_back();  // along an existing edge: the face stays
+      continue;
+    }
+    for (auto [from, to] : {std::pair{i_in, i_out}, std::pair{i_out, i_in}}) {
+      std::vector<std::int32_t> sub;
+      for (std::size_t i = from;; i = (i + 1) % m) {
+        sub.push_back(poly[i]);
+        if (i == to) break;
+      }
+      if (sub.size() == 3) {
+        a.added_faces.push_back({sub[0], sub[1], sub[2]});
+      } else {  // a quad: along its shorter diagonal
+        if ((position_of(sub[0]) - position_of(sub[2])).squaredNorm() <=
+            (position_of(sub[1]) - position_of(sub[3])).squaredNorm()) {
+          a.added_faces.push_back({sub[0], sub[1], sub[2]});
+          a.added_faces.push_back({sub[0], sub[2], sub[3]});
+        } else {
+          a.added_faces.push_back({sub[0], sub[1], sub[3]});
+          a.added_faces.push_back({sub[1], sub[2], sub[3]});
+        }
+      }
+    }
+  }
+  std::sort(a.removed_faces.begin(), a.removed_faces.end());
+  a.removed_faces.erase(std::unique(a.removed_faces.begin(), a.removed_faces.end()),
+                        a.removed_faces.end());
+  apply(mesh_, a, &adjacency_);
+  step.changes.push_back(std::move(a));
+
+  // Phase B: duplicate the interior points for the faces on the path's left, found by turning
+  // counter-clockwise around each from the outgoing path edge to the incoming one (or to the
+  // open slit, at the old tip).
+  TopologyChange b;
+  b.base_vertex_count = mesh_.vertex_count();
+  b.base_face_count = mesh_.face_count();
+  std::map<std::int32_t, Face> remapped;
+  const std::int32_t prev_tip = path_.size() >= 2 ? path_[path_.size() - 2].right : -1;
+  std::vector<std::int32_t> dups(points.size(), -1);
+  std::vector<Eigen::Vector3d> left_dir(points.size(), n);
+  for (std::size_t j = 0; j + 1 < points.size(); ++j) {
+    if (j == 0 && path_.size() == 1) continue;  // the start of the tear stays one point
+    const std::int32_t p = points[j], next = points[j + 1];
+    const std::int32_t prev = j == 0 ? prev_tip : points[j - 1];
+    const std::int32_t h0 = adjacency_.find(p, next);
+    if (h0 < 0) continue;
+    std::vector<std::int32_t> faces;
+    std::int32_t h = h0;
+    bool ok = true;
+    for (int guard = 0;; ++guard) {
+      faces.push_back(h / 3);
+      const std::int32_t pv = 3 * (h / 3) + (h % 3 + 2) % 3;
+      const std::int32_t o = adjacency_.twin(pv);
+      if (o < 0) break;
+      const Face& of = mesh_.faces[static_cast<std::size_t>(o / 3)];
+      if (of[(o % 3 + 1) % 3] == prev) break;  // reached the incoming path edge
+      if (o == h0 || guard > 4096) {
+        ok = false;
+        break;
+      }
+      h = o;
+    }
+    if (!ok) continue;  // no incoming edge around: leave this point joined
+    const std::int32_t dup = b.base_vertex_count + static_cast<std::int32_t>(b.new_vertices.size());
+    b.new_vertices.push_back(NewVertex::duplicate(p));
+    dups[j] = dup;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (auto fi : faces) {
+      auto it = remapped.try_emplace(fi, mesh_.faces[static_cast<std::size_t>(fi)]).first;
+      for (auto& v : it->second)
+        if (v == p) v = dup;
+      const Face& f = mesh_.faces[static_cast<std::size_t>(fi)];
+      centroid += (mesh_.current.col(f[0]) + mesh_.current.col(f[1]) + mesh_.current.col(f[2])) / 3;
+    }
+    centroid /= static_cast<double>(faces.size());
+    left_dir[j] = (centroid - mesh_.current.col(p)).dot(n) >= 0 ? n : Eigen::Vector3d(-n);
+  }
+  for (const auto& [fi, f] : remapped) {
+    b.removed_faces.push_back(fi);
+    b.added_faces.push_back(f);
+  }
+  if (!b.empty()) {
+    apply(mesh_, b, &adjacency_);
+    step.changes.push_back(std::move(b));
+  }
+
+  // Record the path: the old tip becomes interior, then the Q_j, then the new tip.
+  path_.back().left = dups[0];
+  path_.back().normal = left_dir[0];
+  for (std::size_t j = 1; j < points.size(); ++j)
+    path_.push_back({points[j], j + 1 < points.size() ? dups[j] : -1, left_dir[j]});
+  tip_neighbor_ = points[points.size() - 2];
+  tip_ = points.back();
+  ++steps_;
+  step.extended = true;
+  message_.clear();
+  return step;
+}
+
+double Tear::length() const {
+  double l = 0;
+  for (std::size_t i = 1; i < path_.size(); ++i)
+    l += (mesh_.current.col(path_[i].right) - mesh_.current.col(path_[i - 1].right)).norm();
+  return l;
+}
+
+std::vector<std::int32_t> Tear::left_border() const {
+  std::vector<std::int32_t> out;
+  for (const auto& p : path_) out.push_back(p.left >= 0 ? p.left : p.right);
+  return out;
+}
+
+std::vector<std::int32_t> Tear::right_border() const {
+  std::vector<std::int32_t> out;
+  for (const auto& p : path_) out.push_back(p.right);
+  return out;
+}
+
+std::vector<std::pair<std::int32_t, Eigen::Vector3d>> Tear::open(double amount) {
+  if (!std::isfinite(amount) || amount < 0)
+    throw std::invalid_argument("tear: the opening must be finite and ≥ 0");
+  std::vector<std::pair<std::int32_t, Eigen::Vector3d>> out;
+  const double total = length();
+  if (path_.size() < 3 || !(total > 0) || amount == 0) return out;
+  std::vector<Eigen::Vector3d> delta(path_.size(), Eigen::Vector3d::Zero());
+  double s = 0;
+  for (std::size_t i = 1; i + 1 < path_.size(); ++i) {
+    s += (mesh_.current.col(path_[i].right) - mesh_.current.col(path_[i - 1].right)).norm();
+    if (path_[i].left < 0) continue;
+    delta[i] = 0.5 * amount * std::sin(std::numbers::pi * s / total) * path_[i].normal;
+  }
+  for (std::size_t i = 1; i + 1 < path_.size(); ++i) {
+    if (path_[i].left < 0) continue;
+    mesh_.current.col(path_[i].left) += delta[i];
+    mesh_.current.col(path_[i].right) -= delta[i];
+    out.emplace_back(path_[i].left, delta[i]);
+    out.emplace_back(path_[i].right, -delta[i]);
+  }
+  return out;
+}
+
+}  // namespace conform::mesh

@@ -1,0 +1,221 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <random>
+
+#include "conform/cga/versor.hpp"
+#include "conform/mesh/analysis.hpp"
+#include "conform/mesh/primitives.hpp"
+#include "conform/mesh/procedural_arm.hpp"
+#include "conform/mesh/tear.hpp"
+
+using namespace conform;
+using namespace conform::mesh;
+
+namespace {
+
+double border_length(const SkinnedMesh& m, const std::vector<std::int32_t>& b) {
+  double l = 0;
+  for (std::size_t i = 1; i < b.size(); ++i)
+    l += (m.current.col(b[i]) - m.current.col(b[i - 1])).norm();
+  return l;
+}
+
+// Invariants of a torn mesh: valid, manifold, oriented, no slivers, one piece, area kept, the
+// borders are boundary edges of equal length.
+void expect_torn(const SkinnedMesh& m, const SkinnedMesh& in, const Tear& tear,
+                 const std::string& what) {
+  const MeshReport r = check_mesh(m, 1e-14 * std::pow(bounding_diagonal(in), 2));
+  EXPECT_TRUE(r.indices_valid) << what;
+  EXPECT_EQ(r.tiny_faces, 0) << what;
+  EXPECT_TRUE(r.manifold()) << what << ": " << r.summary();
+  EXPECT_TRUE(r.oriented()) << what;
+  EXPECT_EQ(label_pieces(m).count, label_pieces(in).count) << what;
+  const double a0 = surface_area(in);
+  EXPECT_NEAR(surface_area(m), a0, 1e-9 * a0) << what;
+  const auto left = tear.left_border(), right = tear.right_border();
+  EXPECT_NEAR(border_length(m, left), border_length(m, right), 1e-12) << what;
+  // Every interior border edge is now a boundary edge (the tear is open there).
+  const Adjacency adj(m);
+  for (std::size_t i = 1; i + 1 < left.size(); ++i) {
+    if (left[i] == right[i]) continue;
+    for (const auto& border : {left, right}) {
+      const std::int32_t h1 = adj.find(border[i - 1], border[i]),
+                         h2 = adj.find(border[i], border[i - 1]);
+      EXPECT_TRUE((h1 >= 0) != (h2 >= 0)) << what << " border edge " << i;
+    }
+  }
+  for (Eigen::Index v = 0; v < m.weights.cols(); ++v)
+    ASSERT_NEAR(m.weights.col(v).sum(), 1.0, 1e-12) << what;
+}
+
+ScalpelSample vertical(double t, double x, double y) {
+  return {t, {x, y, -0.1}, {x, y, 0.1}};
+}
+
+}  // namespace
+
+TEST(Tear, StraightTearAcrossASheetIsOneContinuousTear) {
+  const SkinnedMesh in = make_sheet(40, 40);
+  SkinnedMesh m = in;
+  Adjacency adj(m);
+  Tear tear(m, adj);
+  for (int i = 0; i < 100; ++i) tear.advance(vertical(i, -0.3 + 0.6 * i / 99.0, 0.0371));
+  EXPECT_EQ(tear.steps(), 99) << tear.message();
+  EXPECT_NEAR(tear.length(), 0.6, 0.006);  // through snapped vertices: not quite straight
+  EXPECT_GT(tear.path_length(), 24 + 2);
+  expect_torn(m, in, tear, "straight");
+  // The adjacency kept up to date equals a fresh one.
+  const Adjacency fresh(m);
+  for (std::int32_t h = 0; h < 3 * m.face_count(); ++h) ASSERT_EQ(adj.twin(h), fresh.twin(h)) << h;
+  // Opening moves the borders apart, most in the middle, not at the ends.
+  const auto left = tear.left_border(), right = tear.right_border();
+  const Eigen::Vector3d start = m.current.col(left.front());
+  const auto moved = tear.open(0.02);
+  EXPECT_FALSE(moved.empty());
+  const std::size_t mid = left.size() / 2;
+  EXPECT_NEAR((m.current.col(left[mid]) - m.current.col(right[mid])).norm(), 0.02, 2e-3);
+  EXPECT_LT((m.current.col(left[1]) - m.current.col(right[1])).norm(), 0.004);
+  EXPECT_EQ(m.current.col(left.front()), start) << "the ends stay";
+}
+
+TEST(Tear, CurvedTearOnASheet) {
+  const SkinnedMesh in = make_sheet(50, 50);
+  SkinnedMesh m = in;
+  Adjacency adj(m);
+  Tear tear(m, adj);
+  for (int i = 0; i < 100; ++i) {
+    const double a = 0.2 + 1.2 * std::numbers::pi * i / 99.0;
+    tear.advance(vertical(i, 0.3 * std::cos(a), 0.3 * std::sin(a)));
+  }
+  EXPECT_EQ(tear.steps(), 99) << tear.message();
+  expect_torn(m, in, tear, "arc");
+}
+
+TEST(Tear, AlongTheArm) {
+  const SkinnedMesh in = make_arm(1).mesh;
+  SkinnedMesh m = in;
+  Adjacency adj(m);
+  Tear tear(m, adj);
+  for (int i = 0; i < 100; ++i) {
+    const double z = 0.08 + 0.2 * i / 99.0, a = 0.3 + 0.4 * i / 99.0;
+    tear.advance({double(i), {0, 0, z}, {0.2 * std::cos(a), 0.2 * std::sin(a), z}});
+  }
+  EXPECT_EQ(tear.steps(), 99) << tear.message();
+  expect_torn(m, in, tear, "arm");
+}
+
+TEST(Tear, DegenerateInputs) {
+  const SkinnedMesh in = make_sheet(10, 10);
+  SkinnedMesh m = in;
+  Adjacency adj(m);
+  Tear tear(m, adj);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(tear.advance({0, {nan, 0, 0}, {0, 0, 1}}), std::invalid_argument);
+  EXPECT_THROW(tear.open(-1), std::invalid_argument);
+  // Outside the mesh: never starts, nothing changes.
+  EXPECT_TRUE(tear.advance(vertical(0, 3, 3)).changes.empty());
+  EXPECT_FALSE(tear.started());
+  EXPECT_EQ(m.faces, in.faces);
+  // Starts, then an unmoved blade and a blade that leaves the sheet change nothing more.
+  EXPECT_FALSE(tear.advance(vertical(1, 0.01, 0.02)).changes.empty());
+  EXPECT_TRUE(tear.started());
+  const auto faces = m.faces;
+  EXPECT_TRUE(tear.advance(vertical(2, 0.01, 0.02)).changes.empty());
+  EXPECT_TRUE(tear.advance(vertical(3, 2.0, 0.02)).changes.empty());
+  EXPECT_FALSE(tear.message().empty());
+  // A blade collinear with the tip has no plane.
+  const Eigen::Vector3d tip = m.current.col(m.vertex_count() - 1);
+  EXPECT_TRUE(tear.advance({4, tip + Eigen::Vector3d(0.1, 0, 0), tip + Eigen::Vector3d(0.2, 0, 0)})
+                  .changes.empty());
+  EXPECT_EQ(m.faces, faces);
+  EXPECT_EQ(tear.steps(), 0);
+  // It then continues normally.
+  EXPECT_TRUE(tear.advance(vertical(5, 0.2, 0.02)).extended) << tear.message();
+  expect_torn(m, in, tear, "after degenerate samples");
+}
+
+TEST(Tear, PropertyRandomScalpelPaths) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int extended = 0, attempted = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    const bool sheet = trial % 2 == 0;
+    const SkinnedMesh in = sheet ? make_sheet(30, 30) : make_icosphere(3);
+    SkinnedMesh m = in;
+    Adjacency adj(m);
+    Tear tear(m, adj);
+    // A smooth random path: position and heading with a random turn rate.
+    Eigen::Vector2d p(0.2 * u(rng), 0.2 * u(rng));
+    double heading = std::numbers::pi * u(rng), turn = 0.05 * u(rng);
+    for (int i = 0; i < 40; ++i) {
+      ++attempted;
+      ScalpelSample s;
+      if (sheet) {
+        s = vertical(i, p.x(), p.y());
+      } else {  // a radial blade through the sphere's surface at (lon, lat) = p
+        const Eigen::Vector3d d(std::cos(p.y()) * std::cos(p.x()),
+                                std::cos(p.y()) * std::sin(p.x()), std::sin(p.y()));
+        s = {double(i), 0.5 * d, 1.5 * d};
+      }
+      const bool grew = tear.advance(s).extended;
+      extended += grew;
+      if (!grew && std::getenv("TEAR_DEBUG"))
+        std::printf("%d %d %s\n", trial, i, tear.message().c_str());
+      p += (sheet ? 0.012 : 0.03) * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+      heading += turn;
+    }
+    expect_torn(m, in, tear, (sheet ? "sheet " : "sphere ") + std::to_string(trial));
+    if (testing::Test::HasFailure()) break;
+  }
+  EXPECT_GT(extended, attempted * 8 / 10);
+}
+
+// Linear-blend skinning with one versor per bone.
+Eigen::Matrix3Xd lbs(const SkinnedMesh& m, const std::vector<cga::Versor<double>>& pose) {
+  Eigen::Matrix3Xd out(3, m.rest.cols());
+  for (Eigen::Index v = 0; v < m.rest.cols(); ++v) {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int k = 0; k < kMaxInfluences; ++k)
+      if (m.weights(k, v) != 0)
+        x += m.weights(k, v) * pose[static_cast<std::size_t>(m.bones(k, v))].apply(m.rest.col(v));
+    out.col(v) = x;
+  }
+  return out;
+}
+
+TEST(Tear, ReDeformation) {
+  // Tear the posed arm across the elbow's blend, then re-skin with another pose, against the
+  // original re-skinned with the same changes applied.
+  const SkinnedMesh original = make_arm(1).mesh;
+  using V = cga::Versor<double>;
+  using M = cga::Motor<double>;
+  const std::vector<V> pose2 = {V::from_motor(M::from_translation({0.1, 0, 0})),
+                                V::from_motor(M::from_axis_angle({1, 1, 0}, -0.7)),
+                                V{M::from_axis_angle({0, 0, 1}, 0.5), 0.8}};
+  SkinnedMesh a = original;
+  Adjacency adj(a);
+  Tear tear(a, adj);
+  std::vector<TopologyChange> changes;
+  for (int i = 0; i < 30; ++i) {
+    const double z = 0.27 + 0.06 * i / 29.0;
+    for (auto& c : tear.advance({double(i), {0, 0, z}, {0.2, 0.05, z}}).changes)
+      changes.push_back(std::move(c));
+  }
+  ASSERT_GT(tear.steps(), 20) << tear.message();
+  a.current = lbs(a, pose2);
+  SkinnedMesh b = original;
+  b.current = lbs(original, pose2);
+  for (const auto& c : changes) apply(b, c);
+  ASSERT_EQ(a.faces, b.faces);
+  double worst = 0;
+  for (Eigen::Index v = 0; v < a.current.cols(); ++v)
+    worst = std::max(worst, (a.current.col(v) - b.current.col(v)).norm());
+  for (Eigen::Index v = 0; v < original.vertex_count(); ++v)
+    ASSERT_EQ(a.current.col(v), b.current.col(v));
+  // New vertices: exact where their parents share influences; the LBS t(1 − t) term elsewhere.
+  EXPECT_LT(worst, 2e-3);
+  RecordProperty("worst_new_vertex_error", std::to_string(worst));
+}
