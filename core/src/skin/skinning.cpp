@@ -119,12 +119,28 @@ void SoaPoints<T>::to(Eigen::Matrix3Xd& p) const {
 template <class T>
 void versor_kernels(std::span<const Versor> versors, std::span<Kernel34<T>> out) {
   for (std::size_t n = 0; n < versors.size(); ++n) {
-    // down(V up(x) V⁻¹) = d R x + t  (versor.hpp), i.e. A = d R, b = t.
-    const auto k = versors[n].kernel();
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) out[n].m[4 * r + c] = static_cast<T>(k.a(r, c));
-      out[n].m[4 * r + 3] = static_cast<T>(k.b(r));
-    }
+    // down(V up(x) V⁻¹) = d R x + t (versor.hpp): A = d R, b = t. From the motor's components
+    // directly, q = (w, v) = (s, −e23, e13, −e12), dual part ε = (ε0, εv) = (−e123∞, −e1∞,
+    // −e2∞, −e3∞), N = |q|²:
+    //   R = ((w² − |v|²) I + 2 v vᵀ + 2 w [v]×) / N,   t = 2 (w εv − ε0 v + v × εv) / N.
+    const auto& m = versors[n].motor;
+    const double w = m.s, x = -m.e23, y = m.e13, z = -m.e12;
+    const double e0 = -m.e123inf, ex = -m.e1inf, ey = -m.e2inf, ez = -m.e3inf;
+    const double inv = 1 / (w * w + x * x + y * y + z * z);
+    const double d = versors[n].scale * inv, t2 = 2 * inv;
+    T* k = out[n].m;
+    k[0] = static_cast<T>((w * w + x * x - y * y - z * z) * d);
+    k[1] = static_cast<T>(2 * (x * y - w * z) * d);
+    k[2] = static_cast<T>(2 * (x * z + w * y) * d);
+    k[3] = static_cast<T>(t2 * (w * ex - e0 * x + (y * ez - z * ey)));
+    k[4] = static_cast<T>(2 * (x * y + w * z) * d);
+    k[5] = static_cast<T>((w * w - x * x + y * y - z * z) * d);
+    k[6] = static_cast<T>(2 * (y * z - w * x) * d);
+    k[7] = static_cast<T>(t2 * (w * ey - e0 * y + (z * ex - x * ez)));
+    k[8] = static_cast<T>(2 * (x * z - w * y) * d);
+    k[9] = static_cast<T>(2 * (y * z + w * x) * d);
+    k[10] = static_cast<T>((w * w - x * x - y * y + z * z) * d);
+    k[11] = static_cast<T>(t2 * (w * ez - e0 * z + (x * ey - y * ex)));
   }
 }
 
@@ -163,7 +179,7 @@ std::string validate_skin_io(const SkinInput<T>& in, const SkinOutput<T>& out,
 }
 
 int skin_threads(int threads, std::size_t vertex_count) {
-  if (vertex_count < 4096) return 1;
+  if (vertex_count < 1024) return 1;
   return threads > 0 ? threads : omp_get_max_threads();
 }
 

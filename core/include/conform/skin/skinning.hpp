@@ -108,7 +108,7 @@ std::string validate_skin_io(const SkinInput<T>& in, const SkinOutput<T>& out,
                              std::size_t bone_count);
 
 /// OpenMP thread count used by the jobs: `threads` if > 0, else the OpenMP default; 1 for
-/// small meshes, where forking costs more than it saves.
+/// meshes under 1024 vertices, where forking costs more than it saves.
 int skin_threads(int threads, std::size_t vertex_count);
 
 template <class T>
