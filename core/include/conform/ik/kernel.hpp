@@ -133,7 +133,8 @@ struct KernelConstants {
   T k_half;    // 1 / (2 √(d1 d2))
   T two_d1d2;  // 2 d1 d2
   T inv_d1;
-  T tiny;                     // |Pw| below this is "at the shoulder"
+  T tiny, tiny2;  // |Pw| below this is "at the shoulder"; its square
+  T inv_reach_max, inv_reach_min;
   bool limit_max, limit_min;  // the elbow range narrows reach_max / reach_min
   T axis_tol2;                // (64 ε)²: squared sine of the angle to the z axis
 
@@ -156,6 +157,9 @@ struct KernelConstants {
     c.two_d1d2 = T(2 * d1 * d2);
     c.inv_d1 = T(1 / d1);
     c.tiny = T(tiny);
+    c.tiny2 = T(tiny * tiny);
+    c.inv_reach_max = T(1) / c.reach_max;
+    c.inv_reach_min = T(1) / c.reach_min;
     c.limit_max = flex_min > 0;
     c.limit_min = flex_max < std::numbers::pi;
     const double tol = 64 * std::numeric_limits<T>::epsilon();
@@ -215,25 +219,32 @@ template <class T, bool kVector = true>
   phi = sel(valid, phi, T(0));
   const T r2 = sel(valid, r2_in, T(1));
 
-  // Direction and clamped distance (eq 10).
-  const T inv_r = rsqrt(sel(r2 > T(0), r2, T(1)));
-  const T l0 = r2 * inv_r;
-  const bool at_shoulder = !(l0 > c.tiny);
-  const T inv_l0 = sel(at_shoulder, T(1), inv_r);
-  const T ux = sel(at_shoulder, T(0), px * inv_l0);
-  const T uy = sel(at_shoulder, T(0), py * inv_l0);
-  const T uz = sel(at_shoulder, T(1), pz * inv_l0);
+  // Direction and clamped distance (eq 10). The roots below depend on the inputs only, so
+  // they run side by side (short latency for one solve).
+  const bool at_shoulder = r2 <= c.tiny2;
+  px = sel(at_shoulder, T(0), px);  // the direction of a target at the shoulder is +z
+  py = sel(at_shoulder, T(0), py);
+  pz = sel(at_shoulder, T(1), pz);
+  const T r2d = sel(at_shoulder, T(1), r2);
+  const T inv_r = rsqrt(r2d);
+  const T l0 = sel(at_shoulder, T(0), r2d * inv_r);
+  const T ux = px * inv_r, uy = py * inv_r, uz = pz * inv_r;  // P̂
   const T l = min0(max0(l0, c.reach_min), c.reach_max);
-  const T inv_l = rsqrt(l * l);
+  const T inv_l =
+      sel(l0 > c.reach_max, c.inv_reach_max, sel(l0 < c.reach_min, c.inv_reach_min, inv_r));
 
-  // Swivel reference (eq 11): n0 = P̂ × r, g = P̂ × n0, unit after scaling by 1/|n0|.
-  const bool on_axis = ux * ux + uy * uy <= c.axis_tol2;
-  const T n0x = sel(on_axis, T(0), uy);
-  const T n0y = sel(on_axis, uz, -ux);
-  const T n0z = sel(on_axis, -uy, T(0));
-  const T inv_n0 = rsqrt(n0x * n0x + n0y * n0y + n0z * n0z);
-  const T ax = n0x * inv_n0, ay = n0y * inv_n0, az = n0z * inv_n0;                 // n̂0
-  const T gx = uy * az - uz * ay, gy = uz * ax - ux * az, gz = ux * ay - uy * ax;  // P̂ × n̂0
+  // Swivel reference (eq 11): n0 = Pw × r, r = ẑ (x̂ when Pw is on the z axis); n̂0 and
+  // ĝ = P̂ × n̂0 = (Pw × n0)/(|Pw||n0|) span the plane normal to Pw.
+  const T rho2 = px * px + py * py;
+  const bool on_axis = rho2 <= c.axis_tol2 * r2d;
+  const T n0x = sel(on_axis, T(0), py);
+  const T n0y = sel(on_axis, pz, -px);
+  const T n0z = sel(on_axis, -py, T(0));
+  const T inv_n0 = rsqrt(sel(on_axis, py * py + pz * pz, rho2));
+  const T ax = n0x * inv_n0, ay = n0y * inv_n0, az = n0z * inv_n0;  // n̂0
+  const T inv_rn = inv_r * inv_n0;
+  const T gx = (py * n0z - pz * n0y) * inv_rn, gy = (pz * n0x - px * n0z) * inv_rn,
+          gz = (px * n0y - py * n0x) * inv_rn;  // P̂ × n̂0
   const SinCos<T> sc = sincos(phi);
   const T nx = sc.c * ax + sc.s * gx, ny = sc.c * ay + sc.s * gy, nz = sc.c * az + sc.s * gz;
   const T wx = sc.s * ax - sc.c * gx, wy = sc.s * ay - sc.c * gy, wz = sc.s * az - sc.c * gz;  // û
