@@ -307,6 +307,35 @@ TEST(IkReadable, AgreesWithFastAndReachesTargets) {
   EXPECT_LE(worst_plane, 1e-12 * scale);
 }
 
+// In float the paper's half-angle formulas √((1 ± c)/2) (eqs 8, 9, 16), which the readable
+// version keeps, lose half the digits near a zero angle (√ε ≈ 2.4e-4): the readable float solver
+// is good to about 1e-4 of the reach, the closed form (scalar entry point) to 1e-6.
+TEST(IkReadable, FloatPrecisionOfBothVersions) {
+  const ik::Arm<float> arm;
+  const ik::Arm<double> armd{double(arm.upper), double(arm.fore), {}};
+  const double scale = armd.upper + armd.fore;
+  const auto t = random_targets<float>(3000, arm.upper, arm.fore, 31);
+  double worst_readable = 0, worst_fast = 0;
+  for (std::size_t i = 0; i < t.x.size(); ++i) {
+    const Eigen::Vector3f p(t.x[i], t.y[i], t.z[i]);
+    const Vec3d goal = p.cast<double>();
+    const auto r = ik::solve_readable(arm, p, t.phi[i]);
+    const auto f = ik::solve(arm, p, t.phi[i]);
+    worst_readable = std::max(
+        worst_readable,
+        (ik::forward_kinematics(armd, r.qs.cast<double>(), r.qe.cast<double>()).wrist - goal)
+            .norm());
+    worst_fast = std::max(
+        worst_fast,
+        (ik::forward_kinematics(armd, f.qs.cast<double>(), f.qe.cast<double>()).wrist - goal)
+            .norm());
+  }
+  std::printf("float: readable worst wrist %.3g of reach, closed form %.3g\n",
+              worst_readable / scale, worst_fast / scale);
+  EXPECT_LE(worst_readable, 1e-3 * scale);
+  EXPECT_LE(worst_fast, 2e-6 * scale);
+}
+
 // The elbow branch is explicit: the elbow is on the side n̂ × P̂ of the shoulder–wrist line,
 // and at φ = 0 it is displaced towards +z. Both solvers.
 TEST(IkBranch, ElbowSideIsConsistent) {
