@@ -19,12 +19,15 @@ using V3 = Eigen::Vector3d;
 namespace {
 
 std::mt19937_64 rng(42);
-double uniform() { return std::uniform_real_distribution<>(-1, 1)(rng); }
+double uniform() {
+  return std::uniform_real_distribution<>(-1, 1)(rng);
+}
 cga::Quat<double> random_quat() {
   return cga::Quat<double>(uniform(), uniform(), uniform(), uniform()).normalized();
 }
 cga::Motor<double> random_motor() {
-  return cga::Motor<double>::from_rotation_translation(random_quat(), V3(uniform(), uniform(), uniform()));
+  return cga::Motor<double>::from_rotation_translation(random_quat(),
+                                                       V3(uniform(), uniform(), uniform()));
 }
 
 constexpr int kSmall = 1024;  // independent inputs per iteration for the scalar kernels
@@ -41,7 +44,8 @@ BENCHMARK(BM_GeometricProduct);
 
 void BM_Eigen4x4Product(benchmark::State& state) {
   std::vector<Eigen::Matrix4d> a(kSmall), b(kSmall);
-  for (int i = 0; i < kSmall; ++i) a[i] = Eigen::Matrix4d::Random(), b[i] = Eigen::Matrix4d::Random();
+  for (int i = 0; i < kSmall; ++i)
+    a[i] = Eigen::Matrix4d::Random(), b[i] = Eigen::Matrix4d::Random();
   for (auto _ : state)
     for (int i = 0; i < kSmall; ++i) benchmark::DoNotOptimize((a[i] * b[i]).eval());
   state.SetItemsProcessed(state.iterations() * kSmall);
@@ -127,7 +131,8 @@ BENCHMARK(BM_QuaternionRotateTranslate);
 void BM_Eigen4x4Vector(benchmark::State& state) {
   std::vector<Eigen::Matrix4d> m(kSmall);
   std::vector<Eigen::Vector4d> p(kSmall);
-  for (int i = 0; i < kSmall; ++i) m[i] = Eigen::Matrix4d::Random(), p[i] = Eigen::Vector4d::Random();
+  for (int i = 0; i < kSmall; ++i)
+    m[i] = Eigen::Matrix4d::Random(), p[i] = Eigen::Vector4d::Random();
   for (auto _ : state)
     for (int i = 0; i < kSmall; ++i) benchmark::DoNotOptimize((m[i] * p[i]).eval());
   state.SetItemsProcessed(state.iterations() * kSmall);
@@ -183,9 +188,10 @@ BENCHMARK(BM_VersorPointBatch)->Unit(benchmark::kMillisecond);
 
 void BM_MotorPointBatchFloat(benchmark::State& state) {
   std::vector<float> x(kBatch), y(kBatch), z(kBatch), ox(kBatch), oy(kBatch), oz(kBatch);
-  for (std::size_t i = 0; i < kBatch; ++i) x[i] = float(uniform()), y[i] = float(uniform()), z[i] = float(uniform());
-  const auto motor = cga::Motor<float>::from_rotation_translation(random_quat().cast<float>(),
-                                                                  Eigen::Vector3f(0.1f, 0.2f, 0.3f));
+  for (std::size_t i = 0; i < kBatch; ++i)
+    x[i] = float(uniform()), y[i] = float(uniform()), z[i] = float(uniform());
+  const auto motor = cga::Motor<float>::from_rotation_translation(
+      random_quat().cast<float>(), Eigen::Vector3f(0.1f, 0.2f, 0.3f));
   for (auto _ : state) {
     cga::apply_batch<float>(motor.kernel(), {x, y, z}, {ox, oy, oz});
     benchmark::ClobberMemory();
@@ -196,7 +202,8 @@ BENCHMARK(BM_MotorPointBatchFloat)->Unit(benchmark::kMillisecond);
 
 void BM_EigenIsometryBatchFloat(benchmark::State& state) {
   Eigen::Matrix3Xf in = Eigen::Matrix3Xf::Random(3, kBatch), out(3, kBatch);
-  const Eigen::Isometry3f iso = Eigen::Translation3f(0.1f, 0.2f, 0.3f) * random_quat().cast<float>();
+  const Eigen::Isometry3f iso =
+      Eigen::Translation3f(0.1f, 0.2f, 0.3f) * random_quat().cast<float>();
   for (auto _ : state) {
     out.noalias() = iso * in;
     benchmark::ClobberMemory();
@@ -218,7 +225,8 @@ BENCHMARK(BM_EigenIsometryBatch)->Unit(benchmark::kMillisecond);
 
 void BM_EigenAffineScaledBatch(benchmark::State& state) {
   Eigen::Matrix3Xd in = Eigen::Matrix3Xd::Random(3, kBatch), out(3, kBatch);
-  const Eigen::Affine3d aff = Eigen::Translation3d(V3::Random()) * random_quat() * Eigen::Scaling(1.7);
+  const Eigen::Affine3d aff =
+      Eigen::Translation3d(V3::Random()) * random_quat() * Eigen::Scaling(1.7);
   for (auto _ : state) {
     out.noalias() = aff * in;
     benchmark::ClobberMemory();
@@ -251,8 +259,10 @@ int main(int argc, char** argv) {
   add_ratio("BM_MotorPointSingle", "BM_Eigen4x4Vector");
   add_ratio("BM_MotorPointSingle", "BM_MotorPointGeneralSandwich");
   add_ratio("BM_MotorKernelPoint", "BM_EigenIsometryVector");
-  add_ratio("BM_MotorPointBatchFloat", "BM_EigenIsometryBatchFloat", "vs BM_EigenIsometryBatchFloat (goal <= 1.0)");
-  add_ratio("BM_MotorPointBatch", "BM_EigenIsometryBatch", "vs BM_EigenIsometryBatch (goal <= 1.0)");
+  add_ratio("BM_MotorPointBatchFloat", "BM_EigenIsometryBatchFloat",
+            "vs BM_EigenIsometryBatchFloat (goal <= 1.0)");
+  add_ratio("BM_MotorPointBatch", "BM_EigenIsometryBatch",
+            "vs BM_EigenIsometryBatch (goal <= 1.0)");
   add_ratio("BM_MotorPointBatch", "BM_Eigen4x4Batch");
   add_ratio("BM_VersorPointBatch", "BM_EigenAffineScaledBatch");
   return conform::bench::run_with_ratios(argc, argv);

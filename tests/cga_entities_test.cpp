@@ -1,8 +1,7 @@
 // Graded entities and predicates: spheres, planes, circles, lines, point pairs.
 #include <gtest/gtest.h>
 
-#include <random>
-
+#include "cga_random.hpp"
 #include "conform/cga.hpp"
 
 namespace cga = conform::cga;
@@ -10,13 +9,16 @@ using MV = cga::Multivector<double>;
 using V3 = cga::Vec3<double>;
 
 namespace {
-std::mt19937_64& rng() {
-  static std::mt19937_64 r(99);
-  return r;
+cga::testing::Random random(99);
+double uniform(double a = -1, double b = 1) {
+  return random.uniform(a, b);
 }
-double uniform(double a = -1, double b = 1) { return std::uniform_real_distribution<>(a, b)(rng()); }
-V3 random_vec(double scale = 1) { return V3(uniform(), uniform(), uniform()) * scale; }
-V3 random_unit() { return random_vec().normalized(); }
+V3 random_vec(double scale = 1) {
+  return random.vec(scale);
+}
+V3 random_unit() {
+  return random.unit();
+}
 }  // namespace
 
 TEST(Sphere, ThroughFourPointsRecoversCentreAndRadius) {
@@ -32,10 +34,12 @@ TEST(Sphere, ThroughFourPointsRecoversCentreAndRadius) {
     EXPECT_TRUE(s->contains(inside));
     EXPECT_FALSE(s->contains(outside));
     // Every point of the sphere is on it: X·S = 0.
-    EXPECT_NEAR(dot(cga::Point<double>::up(c + r * random_unit()), *s), 0.0, 1e-7 * (1 + c.squaredNorm()));
+    EXPECT_NEAR(dot(cga::Point<double>::up(c + r * random_unit()), *s), 0.0,
+                1e-7 * (1 + c.squaredNorm()));
   }
   // Coplanar points give no sphere.
-  EXPECT_FALSE(cga::Sphere<double>::through(V3(0, 0, 0), V3(1, 0, 0), V3(0, 1, 0), V3(1, 1, 0)).has_value());
+  EXPECT_FALSE(
+      cga::Sphere<double>::through(V3(0, 0, 0), V3(1, 0, 0), V3(0, 1, 0), V3(1, 1, 0)).has_value());
 }
 
 TEST(Plane, ThroughThreePointsAndSignedDistance) {
@@ -107,7 +111,9 @@ TEST(PointPair, CircleCutByPlaneDissectsIntoItsTwoPoints) {
   const auto s = cga::Sphere<double>::from_center_radius(V3::Zero(), 1);
   const auto eq = cga::Plane<double>::from_normal_distance(V3(0, 0, 1), 0);
   const auto far = cga::Plane<double>::from_normal_distance(V3(1, 0, 0), 5);
-  EXPECT_FALSE(cga::PointPair<double>::meet(cga::Circle<double>{s.mv() ^ eq.mv()}, far).dissect().has_value());
+  EXPECT_FALSE(cga::PointPair<double>::meet(cga::Circle<double>{s.mv() ^ eq.mv()}, far)
+                   .dissect()
+                   .has_value());
 }
 
 TEST(Line, MeetOfTwoPlanesAndThroughTwoPoints) {
@@ -115,7 +121,8 @@ TEST(Line, MeetOfTwoPlanesAndThroughTwoPoints) {
     const V3 a = random_vec(3), b = random_vec(3);
     const cga::Line<double> l = cga::Line<double>::through(a, b);
     const V3 dir = (b - a).normalized();
-    EXPECT_LT((l.direction() - dir).norm(), 1e-9) << l.direction().transpose() << " vs " << dir.transpose();
+    EXPECT_LT((l.direction() - dir).norm(), 1e-9)
+        << l.direction().transpose() << " vs " << dir.transpose();
     // Points of the line satisfy X ∧ L_outer = 0, i.e. X⌋L_inner = 0.
     const V3 on = a + uniform(-2, 2) * (b - a);
     const MV x = cga::Point<double>::up(on).mv();

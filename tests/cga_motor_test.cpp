@@ -3,8 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <numbers>
-#include <random>
-
+#include "cga_random.hpp"
 #include "conform/cga.hpp"
 
 namespace cga = conform::cga;
@@ -15,17 +14,19 @@ using Motor = cga::Motor<double>;
 
 namespace {
 
-std::mt19937_64& rng() {
-  static std::mt19937_64 r(7);
-  return r;
+cga::testing::Random random(7);
+double uniform(double a = -1, double b = 1) {
+  return random.uniform(a, b);
 }
-double uniform(double a = -1, double b = 1) { return std::uniform_real_distribution<>(a, b)(rng()); }
-V3 random_vec(double scale = 1) { return V3(uniform(), uniform(), uniform()) * scale; }
+V3 random_vec(double scale = 1) {
+  return random.vec(scale);
+}
 Q random_quat() {
-  Q q(uniform(), uniform(), uniform(), uniform());
-  return q.normalized();
+  return random.quat();
 }
-Motor random_motor() { return Motor::from_rotation_translation(random_quat(), random_vec(5)); }
+Motor random_motor() {
+  return random.motor();
+}
 
 void expect_vec_near(const V3& a, const V3& b, double tol, const std::string& what) {
   ASSERT_LE((a - b).norm(), tol) << what << ": " << a.transpose() << " vs " << b.transpose();
@@ -141,8 +142,8 @@ TEST(Motor, ExpLogRoundTrip) {
 
 TEST(Motor, ExpMatchesSeriesOfTheGeneralAlgebra) {
   for (int n = 0; n < 300; ++n) {
-    cga::MotorBivector<double> b{uniform(), uniform(), uniform(), uniform(-3, 3), uniform(-3, 3),
-                                 uniform(-3, 3)};
+    cga::MotorBivector<double> b{uniform(),      uniform(),      uniform(),
+                                 uniform(-3, 3), uniform(-3, 3), uniform(-3, 3)};
     const MV series = cga::exp(b.mv());
     const MV closed = cga::exp(b).mv();
     for (int i = 0; i < cga::kBladeCount; ++i) ASSERT_NEAR(closed[i], series[i], 1e-11);

@@ -1,8 +1,7 @@
 // Property tests of the general multivector: identities over thousands of random inputs.
 #include <gtest/gtest.h>
 
-#include <random>
-
+#include "cga_random.hpp"
 #include "conform/cga.hpp"
 
 namespace cga = conform::cga;
@@ -11,22 +10,20 @@ using V3 = cga::Vec3<double>;
 
 namespace {
 
-std::mt19937_64& rng() {
-  static std::mt19937_64 r(20261122);
-  return r;
+cga::testing::Random random(20261122);
+double uniform(double a = -1, double b = 1) {
+  return random.uniform(a, b);
 }
-double uniform(double a = -1, double b = 1) { return std::uniform_real_distribution<>(a, b)(rng()); }
-V3 random_vec(double scale = 1) { return V3(uniform(), uniform(), uniform()) * scale; }
+V3 random_vec(double scale = 1) {
+  return random.vec(scale);
+}
 MV random_mv() {
-  MV m;
-  for (int i = 0; i < cga::kBladeCount; ++i) m[i] = uniform();
-  return m;
+  return random.multivector();
 }
 MV random_vector() {
-  MV m;
-  for (int i = 1; i <= 5; ++i) m[i] = uniform();
-  return m;
+  return random.vector();
 }
+
 void expect_mv_near(const MV& a, const MV& b, double tol, const std::string& what) {
   for (int i = 0; i < cga::kBladeCount; ++i)
     ASSERT_NEAR(a[i], b[i], tol) << what << " blade " << cga::blade_name(i) << "\n a = " << a
@@ -49,7 +46,8 @@ TEST(Multivector, PointIdentities) {
     const V3 x = random_vec(10), y = random_vec(10);
     const MV X = cga::Point<double>::up(x).mv(), Y = cga::Point<double>::up(y).mv();
     EXPECT_NEAR(scalar_product(X, X), 0.0, 1e-12 * (1 + x.squaredNorm()));
-    EXPECT_NEAR(scalar_product(X, Y), -0.5 * (x - y).squaredNorm(), 1e-11 * (1 + x.squaredNorm() + y.squaredNorm()));
+    EXPECT_NEAR(scalar_product(X, Y), -0.5 * (x - y).squaredNorm(),
+                1e-11 * (1 + x.squaredNorm() + y.squaredNorm()));
     auto back = cga::down(X * 3.5);
     ASSERT_TRUE(back.has_value());
     EXPECT_LT((*back - x).norm(), 1e-12 * (1 + x.norm()));

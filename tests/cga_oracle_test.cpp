@@ -94,6 +94,7 @@ TEST(CgaOracle, EveryLineMatchesGanja) {
     }
     ++counts[l.op];
   }
-  for (const char* op : {"gp", "op", "lc", "rev", "inv_grade", "dual", "versor_inv", "sandwich", "exp"})
+  for (const char* op :
+       {"gp", "op", "lc", "rev", "inv_grade", "dual", "versor_inv", "sandwich", "exp"})
     EXPECT_GT(counts[op], 0) << "no oracle line for " << op;
 }

@@ -49,9 +49,10 @@ template <class T>
 std::optional<Motor<T>> Motor<T>::from_matrix(const Eigen::Matrix<T, 4, 4>& m) {
   const Eigen::Matrix<T, 3, 3> r = m.template topLeftCorner<3, 3>();
   const T tol = T(1e-6);
-  if (!m.allFinite() || (r * r.transpose() - Eigen::Matrix<T, 3, 3>::Identity()).cwiseAbs().maxCoeff() > tol ||
-      std::abs(r.determinant() - T(1)) > tol || std::abs(m(3, 0)) > tol || std::abs(m(3, 1)) > tol ||
-      std::abs(m(3, 2)) > tol || std::abs(m(3, 3) - T(1)) > tol)
+  if (!m.allFinite() ||
+      (r * r.transpose() - Eigen::Matrix<T, 3, 3>::Identity()).cwiseAbs().maxCoeff() > tol ||
+      std::abs(r.determinant() - T(1)) > tol || std::abs(m(3, 0)) > tol ||
+      std::abs(m(3, 1)) > tol || std::abs(m(3, 2)) > tol || std::abs(m(3, 3) - T(1)) > tol)
     return std::nullopt;
   return from_rotation_translation(Quat<T>(r).normalized(), m.template topRightCorner<3, 1>());
 }
@@ -139,8 +140,7 @@ RigidKernel<T> Motor<T>::kernel() const {
       T(2) * (x * z + w * y) * n,  //
       T(2) * (x * y + w * z) * n, (w * w - x * x + y * y - z * z) * n,
       T(2) * (y * z - w * x) * n,  //
-      T(2) * (x * z - w * y) * n, T(2) * (y * z + w * x) * n,
-      (w * w - x * x - y * y + z * z) * n;
+      T(2) * (x * z - w * y) * n, T(2) * (y * z + w * x) * n, (w * w - x * x - y * y + z * z) * n;
   k.b = translation();
   return k;
 }

@@ -55,8 +55,10 @@ std::string Multivector<T>::to_string() const {
   for (int i = 0; i < kBladeCount; ++i) {
     const T x = (*this)[i];
     if (x == T(0)) continue;
-    if (!first) os << (x < 0 ? " - " : " + ");
-    else if (x < 0) os << "-";
+    if (!first)
+      os << (x < 0 ? " - " : " + ");
+    else if (x < 0)
+      os << "-";
     os << std::abs(x);
     if (i != 0) os << "*" << blade_name(i);
     first = false;
@@ -166,7 +168,8 @@ Multivector<T> parse_multivector(std::string_view text) {
       coeff = static_cast<T>(v);
       name = std::string(end);
       std::size_t k = 0;
-      while (k < name.size() && (std::isspace(static_cast<unsigned char>(name[k])) || name[k] == '*'))
+      while (k < name.size() &&
+             (std::isspace(static_cast<unsigned char>(name[k])) || name[k] == '*'))
         ++k;
       name = name.substr(k);
     }

@@ -19,11 +19,10 @@ namespace conform::cga {
 
 std::string_view blade_name(int blade) {
   static constexpr std::array<std::string_view, kBladeCount> kNames = {
-      "1",       "e1",      "e2",      "e3",      "einf",     "e0",      "e12",
-      "e13",     "e1inf",   "e10",     "e23",     "e2inf",    "e20",     "e3inf",
-      "e30",     "einf0",   "e123",    "e12inf",  "e120",     "e13inf",  "e130",
-      "e1inf0",  "e23inf",  "e230",    "e2inf0",  "e3inf0",   "e123inf", "e1230",
-      "e12inf0", "e13inf0", "e23inf0", "e123inf0"};
+      "1",      "e1",     "e2",      "e3",     "einf",    "e0",      "e12",     "e13",
+      "e1inf",  "e10",    "e23",     "e2inf",  "e20",     "e3inf",   "e30",     "einf0",
+      "e123",   "e12inf", "e120",    "e13inf", "e130",    "e1inf0",  "e23inf",  "e230",
+      "e2inf0", "e3inf0", "e123inf", "e1230",  "e12inf0", "e13inf0", "e23inf0", "e123inf0"};
   if (blade < 0 || blade >= kBladeCount) return "?";
   return kNames[static_cast<std::size_t>(blade)];
 }
@@ -71,11 +70,23 @@ Ortho ortho_outer(const Ortho& x, const Ortho& y) {
 Ortho null_vector(int i) {
   Ortho v = Ortho::Zero();
   switch (i) {
-    case 0: v[0b00001] = 1; break;
-    case 1: v[0b00010] = 1; break;
-    case 2: v[0b00100] = 1; break;
-    case 3: v[0b01000] = 1; v[0b10000] = 1; break;      // e∞ = e+ + e−
-    case 4: v[0b01000] = -0.5; v[0b10000] = 0.5; break;  // e0 = ½(e− − e+)
+    case 0:
+      v[0b00001] = 1;
+      break;
+    case 1:
+      v[0b00010] = 1;
+      break;
+    case 2:
+      v[0b00100] = 1;
+      break;
+    case 3:
+      v[0b01000] = 1;
+      v[0b10000] = 1;
+      break;  // e∞ = e+ + e−
+    case 4:
+      v[0b01000] = -0.5;
+      v[0b10000] = 0.5;
+      break;  // e0 = ½(e− − e+)
   }
   return v;
 }

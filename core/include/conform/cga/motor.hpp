@@ -43,7 +43,9 @@ class Motor {
   static Motor identity() { return Motor(); }
   /// Rotation by q (need not be unit: the sandwich divides by |q|²) then translation by t.
   static Motor from_rotation_translation(const Quat<T>& q, const Vec3<T>& t);
-  static Motor from_quaternion(const Quat<T>& q) { return from_rotation_translation(q, Vec3<T>::Zero()); }
+  static Motor from_quaternion(const Quat<T>& q) {
+    return from_rotation_translation(q, Vec3<T>::Zero());
+  }
   static Motor from_translation(const Vec3<T>& t) {
     return from_rotation_translation(Quat<T>::Identity(), t);
   }
@@ -89,17 +91,15 @@ class Motor {
   Vec3<T> apply(const Vec3<T>& x) const { return kernel().apply(x); }
 
   friend Motor operator+(const Motor& a, const Motor& b) {
-    return {a.s + b.s, a.e12 + b.e12, a.e13 + b.e13, a.e23 + b.e23,
+    return {a.s + b.s,         a.e12 + b.e12,     a.e13 + b.e13,     a.e23 + b.e23,
             a.e1inf + b.e1inf, a.e2inf + b.e2inf, a.e3inf + b.e3inf, a.e123inf + b.e123inf};
   }
   friend Motor operator*(const Motor& a, T k) {
-    return {a.s * k, a.e12 * k, a.e13 * k, a.e23 * k,
+    return {a.s * k,     a.e12 * k,   a.e13 * k,   a.e23 * k,
             a.e1inf * k, a.e2inf * k, a.e3inf * k, a.e123inf * k};
   }
   friend Motor operator-(const Motor& a) { return a * T(-1); }
-  T dot_rotation(const Motor& b) const {
-    return s * b.s + e12 * b.e12 + e13 * b.e13 + e23 * b.e23;
-  }
+  T dot_rotation(const Motor& b) const { return s * b.s + e12 * b.e12 + e13 * b.e13 + e23 * b.e23; }
 
  private:
   Motor(T s_, T a, T b, T c, T d, T e, T f, T g)

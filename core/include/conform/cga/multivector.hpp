@@ -168,15 +168,25 @@ Multivector<T> exp(const Multivector<T>& b);
 
 /// Basis vectors as multivectors.
 template <class T = double>
-inline Multivector<T> e1() { return Multivector<T>::blade(kE1); }
+inline Multivector<T> e1() {
+  return Multivector<T>::blade(kE1);
+}
 template <class T = double>
-inline Multivector<T> e2() { return Multivector<T>::blade(kE2); }
+inline Multivector<T> e2() {
+  return Multivector<T>::blade(kE2);
+}
 template <class T = double>
-inline Multivector<T> e3() { return Multivector<T>::blade(kE3); }
+inline Multivector<T> e3() {
+  return Multivector<T>::blade(kE3);
+}
 template <class T = double>
-inline Multivector<T> einf() { return Multivector<T>::blade(kEinf); }
+inline Multivector<T> einf() {
+  return Multivector<T>::blade(kEinf);
+}
 template <class T = double>
-inline Multivector<T> e0() { return Multivector<T>::blade(kE0); }
+inline Multivector<T> e0() {
+  return Multivector<T>::blade(kE0);
+}
 
 extern template class Multivector<float>;
 extern template class Multivector<double>;

@@ -24,8 +24,8 @@ struct Plane : Vector<T> {
   /// Plane through three points: Π = (X1∧X2∧X3∧e∞)*, normalized; its normal is
   /// (b − a) × (c − a) / |…|. Empty when the points are collinear.
   static std::optional<Plane> through(const Vec3<T>& a, const Vec3<T>& b, const Vec3<T>& c) {
-    const Multivector<T> outer = Point<T>::up(a).mv() ^ Point<T>::up(b).mv() ^
-                                 Point<T>::up(c).mv() ^ einf<T>();
+    const Multivector<T> outer =
+        Point<T>::up(a).mv() ^ Point<T>::up(b).mv() ^ Point<T>::up(c).mv() ^ einf<T>();
     Vector<T> v = Vector<T>::from(outer.dual());
     const T len = v.euclidean().norm();
     const T size = std::max({(b - a).norm(), (c - a).norm(), T(1e-300)});

@@ -50,8 +50,7 @@ struct Point : Vector<T> {
     const T size = std::max({std::abs(this->e1), std::abs(this->e2), std::abs(this->e3),
                              std::sqrt(std::abs(this->einf))});
     if (!std::isfinite(w) || !std::isfinite(size) ||
-        std::abs(w) <= T(64) * std::numeric_limits<T>::epsilon() * size ||
-        w == T(0))
+        std::abs(w) <= T(64) * std::numeric_limits<T>::epsilon() * size || w == T(0))
       return std::nullopt;
     return Vec3<T>(this->e1 / w, this->e2 / w, this->e3 / w);
   }

@@ -54,8 +54,8 @@ struct Versor {
 
   friend Versor operator*(const Versor& a, const Versor& b) {
     // D_a M_b D_a⁻¹: same rotation, translation × d_a.
-    const Motor<T> scaled = Motor<T>::from_rotation_translation(
-        b.motor.rotation(), b.motor.translation() * a.scale);
+    const Motor<T> scaled =
+        Motor<T>::from_rotation_translation(b.motor.rotation(), b.motor.translation() * a.scale);
     return {a.motor * scaled, a.scale * b.scale};
   }
   /// Empty when the scale is not positive and finite or the motor is not invertible.
@@ -64,8 +64,8 @@ struct Versor {
     auto mi = motor.inverse();
     if (!mi) return std::nullopt;
     // (M D)⁻¹ = D⁻¹ M⁻¹ = (D⁻¹ M⁻¹ D) D⁻¹: translation of M⁻¹ scaled by 1/d.
-    const Motor<T> scaled = Motor<T>::from_rotation_translation(
-        mi->rotation(), mi->translation() / scale);
+    const Motor<T> scaled =
+        Motor<T>::from_rotation_translation(mi->rotation(), mi->translation() / scale);
     return Versor{scaled, T(1) / scale};
   }
 
