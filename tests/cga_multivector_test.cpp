@@ -11,9 +11,6 @@ using V3 = cga::Vec3<double>;
 namespace {
 
 cga::testing::Random random(20261122);
-double uniform(double a = -1, double b = 1) {
-  return random.uniform(a, b);
-}
 V3 random_vec(double scale = 1) {
   return random.vec(scale);
 }
