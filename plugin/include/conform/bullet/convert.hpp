@@ -12,7 +12,9 @@ btTransform to_transform(const cga::Motor<double>& motor);
 inline btVector3 to_bt(const cga::Vec3<double>& v) {
   return btVector3(btScalar(v.x()), btScalar(v.y()), btScalar(v.z()));
 }
-inline cga::Vec3<double> from_bt(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+inline cga::Vec3<double> from_bt(const btVector3& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 /// "double" when Bullet was built with BT_USE_DOUBLE_PRECISION, else "float".
 const char* bullet_precision();

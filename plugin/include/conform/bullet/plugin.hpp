@@ -1,12 +1,26 @@
 // The one entry point an application attaches to its own Bullet world. It registers a
 // btActionInterface (never the world's single tick-callback slot) and detaches on destruction.
+//
+//   btSoftRigidDynamicsWorld world(...);            // or btSoftMultiBodyDynamicsWorld
+//   conform::bullet::Plugin plugin(world);
+//   auto arm = conform::mesh::make_arm();
+//   auto& skin = plugin.add_skinned_body(arm.mesh, arm.skeleton, material);
+//   skin.set_keyframes(track);                       // or play(animation), set_pose_source(rig)
+//   world.stepSimulation(1.0 / 60);                  // skinning drives the soft body
+//   skin.cut(plane);                                 // between steps
 #pragma once
 
 #include <functional>
 #include <memory>
 #include <vector>
 
+#include "conform/bullet/skinned_soft_body.hpp"
+
 class btDynamicsWorld;
+
+namespace conform::io {
+struct SkinnedModel;
+}
 
 namespace conform::bullet {
 
@@ -15,6 +29,8 @@ class Plugin {
   /// Called once per internal substep, after motion prediction and before constraints.
   using StepHook = std::function<void(double dt)>;
 
+  /// Any Bullet world for step hooks; skinned bodies need a btSoftRigidDynamicsWorld or a
+  /// btSoftMultiBodyDynamicsWorld.
   explicit Plugin(btDynamicsWorld& world);
   ~Plugin();
   Plugin(const Plugin&) = delete;
@@ -24,6 +40,17 @@ class Plugin {
   void add_step_hook(StepHook hook);
   /// Substeps seen since construction.
   long long substeps() const;
+  /// Simulated time seen by the plugin (sum of substep lengths), s.
+  double time() const;
+
+  /// Adds a CGA-skinned soft body built from `mesh` (its current positions) and `skeleton`.
+  /// Throws std::logic_error when the world has no soft bodies, std::invalid_argument on bad
+  /// input. The body lives as long as the plugin (or until remove_skinned_body).
+  SkinnedSoftBody& add_skinned_body(const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton,
+                                    const Material& material = {});
+  SkinnedSoftBody& add_skinned_body(const io::SkinnedModel& model, const Material& material = {});
+  void remove_skinned_body(SkinnedSoftBody& body);
+  std::size_t skinned_body_count() const;
 
  private:
   struct Action;

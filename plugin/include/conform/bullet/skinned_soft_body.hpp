@@ -1,0 +1,204 @@
+// A Bullet soft body whose skinning path is CGA motor skinning (eq 17), and whose topology
+// changes at run time (cut, tear, drill) while it simulates.
+//
+// Mesh ↔ Bullet: nodes = vertices, links = edges of faces, faces = triangles. Every connected
+// piece of the mesh is its own btSoftBody (Bullet's face tree never returns on a body whose
+// faces are not edge-connected); a vertex left without faces (e.g. inside a drilled hole) stays
+// as an isolated node of its piece, so mass is never lost.
+//
+// Each substep (in the plugin's action, after Bullet's motion prediction and before its
+// constraint solve) the pose source gives a skeleton pose, CGA skinning gives every vertex its
+// target, and
+//   kinematic nodes (largest bone weight ≥ Material::kinematic_weight, or pinned) are placed on
+//     their target (Bullet inverse mass 0; velocity (target − previous) / dt);
+//   free nodes are pulled toward their target by an implicit spring–damper per node;
+//   every link's rest length is re-applied from our own copy (Bullet resets rest lengths to the
+//     current lengths after any edit, which would wipe pretension).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "conform/cga/plane.hpp"
+#include "conform/mesh/adjacency.hpp"
+#include "conform/mesh/cut.hpp"
+#include "conform/mesh/drill.hpp"
+#include "conform/mesh/skinned_mesh.hpp"
+#include "conform/mesh/tear.hpp"
+#include "conform/mesh/topology_change.hpp"
+#include "conform/skin/animation.hpp"
+#include "conform/skin/pose.hpp"
+#include "conform/skin/skeleton.hpp"
+#include "conform/skin/skinning.hpp"
+
+class btSoftBody;
+struct btSoftBodyWorldInfo;
+
+namespace conform::bullet {
+
+/// Physical parameters of a skinned soft body. Units are SI (metres, kilograms, seconds).
+struct Material {
+  /// Bullet's linear stiffness kLST, dimensionless in (0, 1]: the fraction of a link's length
+  /// error its position solver removes per iteration.
+  double link_stiffness = 0.9;
+  /// Bullet's damping kDP, dimensionless in [0, 1): fraction of velocity removed per substep.
+  double damping = 0.0;
+  /// Pretension s, dimensionless in [0, 1): a link's rest length is (1 − s) × its length when
+  /// the link is made (at creation, or when a topology change adds it).
+  double pretension = 0.0;
+  /// Areal mass density, kg/m². Each node gets a third of the area of its faces times this
+  /// (skin about 1 mm thick ≈ 1.1 kg/m²).
+  double density = 1.1;
+  /// Pull of a free node toward its skinned target per metre of offset, 1/s² (the squared
+  /// angular frequency of the node's own spring). 0 leaves free nodes to the links alone.
+  double target_stiffness = 400.0;
+  /// Damping of a free node's velocity relative to its target's velocity, 1/s.
+  double target_damping = 20.0;
+  /// Nodes whose largest bone weight is ≥ this are kinematic; > 1 makes none kinematic by
+  /// weight (pinned vertices still are).
+  double kinematic_weight = 0.999;
+  /// Bullet's position iterations per substep.
+  int position_iterations = 4;
+  /// Collision margin of the pieces, m.
+  double margin = 0.005;
+};
+
+/// What one applied TopologyChange did to the Bullet side.
+struct ApplyStats {
+  std::int32_t new_nodes = 0;
+  std::int32_t removed_faces = 0, added_faces = 0;
+  std::int32_t removed_links = 0, added_links = 0;
+  std::int32_t moved_nodes = 0;  // nodes moved into another piece (a split)
+  std::int32_t new_pieces = 0;
+};
+
+class SkinnedSoftBody {
+ public:
+  /// Builds the pieces of `mesh` (its `current` positions are the initial node positions) and
+  /// adds them to the world through `add`. `skeleton` is copied. Throws std::invalid_argument
+  /// on inconsistent input. Normally made by Plugin::add_skinned_body.
+  SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
+                  std::function<void(btSoftBody*)> remove, const mesh::SkinnedMesh& mesh,
+                  const skin::Skeleton& skeleton, const Material& material);
+  ~SkinnedSoftBody();
+  SkinnedSoftBody(const SkinnedSoftBody&) = delete;
+  SkinnedSoftBody& operator=(const SkinnedSoftBody&) = delete;
+
+  // --- Pose sources (the last one set wins). Time is the plugin's simulated time, s. ---
+  /// A fixed pose.
+  void set_pose(const skin::Pose& pose);
+  /// An animation sampled at the simulated time (wrapped when `loop`). The animation is copied.
+  void play(const skin::Animation& animation, skin::Blend blend = skin::Blend::linear,
+            bool loop = true);
+  /// Keyframes set by the user, sampled at the simulated time.
+  void set_keyframes(skin::PoseTrack track, skin::Blend blend = skin::Blend::linear);
+  /// Any other source, e.g. an arm rig: writes the pose for `time` into `pose`.
+  void set_pose_source(std::function<void(double time, skin::Pose& pose)> source);
+  /// Makes these vertices kinematic regardless of their weights (and the rest free unless
+  /// above the weight threshold).
+  void set_pinned(std::span<const std::int32_t> vertices);
+
+  // --- Topology changes: on the simulated positions, only between stepSimulation calls. ---
+  mesh::CutResult cut(const cga::Plane<double>& plane, const mesh::CutOptions& options = {});
+  mesh::DrillResult drill(const mesh::DrillTool& tool, const mesh::DrillOptions& options = {});
+  /// Starts a tear (replacing any earlier one); advance it with tear_advance().
+  void begin_tear(const mesh::TearOptions& options = {});
+  mesh::TearStep tear_advance(const mesh::ScalpelSample& sample);
+  const mesh::Tear* tear() const { return tear_.get(); }
+  /// Applies a change computed by the caller on mesh() (after sync_mesh()).
+  void apply(const mesh::TopologyChange& change);
+  const ApplyStats& last_apply() const { return stats_; }
+
+  // --- State ---
+  /// The mesh with `current` = the simulated node positions as of the last sync_mesh().
+  const mesh::SkinnedMesh& mesh() const { return mesh_; }
+  const skin::Skeleton& skeleton() const { return skeleton_; }
+  const Material& material() const { return material_; }
+  void sync_mesh();
+  std::int32_t vertex_count() const { return mesh_.vertex_count(); }
+  std::int32_t piece_count() const;
+  /// The live pieces' soft bodies.
+  std::vector<btSoftBody*> pieces() const;
+  Eigen::Vector3d position(std::int32_t vertex) const;
+  Eigen::Vector3d velocity(std::int32_t vertex) const;
+  /// Own mass bookkeeping, kg (kinematic nodes have a mass here but inverse mass 0 in Bullet).
+  double mass(std::int32_t vertex) const { return mass_[static_cast<std::size_t>(vertex)]; }
+  bool kinematic(std::int32_t vertex) const { return kinematic_[static_cast<std::size_t>(vertex)]; }
+  /// The Bullet soft body holding `vertex` and its node index there.
+  btSoftBody* body_of(std::int32_t vertex) const;
+  /// The vertex of node `node` of `body` (one of pieces()), or −1.
+  std::int32_t vertex_of(const btSoftBody* body, int node) const;
+  std::int32_t node_of(std::int32_t vertex) const {
+    return node_of_[static_cast<std::size_t>(vertex)];
+  }
+  /// Skinned target of `vertex` from the last substep (or from creation).
+  Eigen::Vector3d target(std::int32_t vertex) const;
+  double total_mass() const;
+  Eigen::Vector3d momentum() const;
+  /// Σ m |v|, the scale against which momentum errors are relative.
+  double momentum_scale() const;
+  /// Our rest length of the link between two vertices (−1 when there is none).
+  double rest_length(std::int32_t u, std::int32_t v) const;
+  std::int32_t link_count() const;
+
+  /// One substep, called by the plugin's action: pose, skin, drive nodes, re-apply rest lengths.
+  void update(double dt, double time);
+  /// Skinning only, for `time` (targets() are then valid); used by update() and benchmarks.
+  void skin_targets(double time);
+
+ private:
+  struct Piece;
+  void pose_at(double time, skin::Pose& pose);
+  Piece& new_piece();
+  void build(const mesh::SkinnedMesh& mesh);
+  void mirror(const mesh::TopologyChange& change);
+  void rebuild_skin_inputs();
+  void set_node_mass(std::int32_t vertex);
+  void add_node(std::int32_t piece, std::int32_t vertex, const Eigen::Vector3d& x,
+                const Eigen::Vector3d& v);
+  void add_face(std::int32_t piece, std::int32_t face);
+  void remove_face_from_bullet(std::int32_t face);
+  void remove_link(std::int32_t piece, std::int32_t link);
+  void add_link(std::int32_t piece, std::int32_t u, std::int32_t v, double rest);
+  void remove_nodes(std::int32_t piece, const std::vector<std::int32_t>& vertices);
+  bool is_kinematic_by_weight(std::int32_t vertex) const;
+
+  btSoftBodyWorldInfo* info_;
+  std::function<void(btSoftBody*)> add_, remove_;
+  mesh::SkinnedMesh mesh_;
+  mesh::Adjacency adjacency_;
+  skin::Skeleton skeleton_;
+  Material material_;
+  std::unique_ptr<mesh::Tear> tear_;
+
+  // Pose source.
+  std::function<void(double, skin::Pose&)> source_;
+  skin::Pose pose_;
+  std::vector<skin::Versor> global_, versors_;
+  std::vector<skin::Kernel34<double>> kernels_;
+  // Skinning inputs/outputs, SoA (see skinning.hpp), rebuilt when vertices are added.
+  skin::SoaPoints<double> rest_soa_, target_, previous_target_;
+  std::vector<std::int32_t> soa_bones_;
+  std::vector<double> soa_weights_;
+  bool fill_previous_ = false;
+
+  // Per vertex.
+  std::vector<std::int32_t> piece_of_, node_of_;
+  std::vector<double> mass_;
+  std::vector<std::uint8_t> kinematic_, pinned_;
+  std::vector<std::vector<std::int32_t>> vertex_faces_;  // incident mesh faces
+  // Per mesh face: the shadow copy of the faces Bullet mirrors, and where each lives.
+  std::vector<mesh::Face> faces_;
+  std::vector<std::int32_t> face_piece_, face_slot_;
+  // Per undirected edge (min, max): faces using it, and its link index in its piece.
+  mesh::EdgeMap edge_faces_, edge_link_;
+
+  std::vector<std::unique_ptr<Piece>> pieces_;  // null once emptied
+  ApplyStats stats_;
+};
+
+}  // namespace conform::bullet
