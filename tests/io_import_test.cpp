@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 #include <assimp/Importer.hpp>
 #include <cmath>
+#include <fstream>
 #include <functional>
 #include <map>
 
@@ -383,6 +384,78 @@ TEST(IoImport, ArmSpecs) {
       EXPECT_NE(std::string(e.what()).find(bad), std::string::npos);
     }
   }
+}
+
+// A file that gives no ticks per second (assimp reports 0) plays at 25 ticks/s; the animated
+// bone moves its vertices. Written at test time: a one-triangle X file with one bone.
+TEST(IoImport, ZeroTicksPerSecondMeans25) {
+  const std::string x = R"(xof 0303txt 0032
+Frame Root {
+  FrameTransformMatrix {
+    1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0;;
+  }
+  Frame Bone1 {
+    FrameTransformMatrix {
+      1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0;;
+    }
+  }
+  Mesh Tri {
+    3;
+    0.0;0.0;0.0;,
+    1.0;0.0;0.0;,
+    0.0;1.0;0.0;;
+    1;
+    3;0,1,2;;
+    XSkinMeshHeader {
+      1;
+      1;
+      1;
+    }
+    SkinWeights {
+      "Bone1";
+      3;
+      0,
+      1,
+      2;
+      1.000000,
+      1.000000,
+      1.000000;
+      1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0,0.0,0.0,0.0,0.0,1.0;;
+    }
+  }
+}
+AnimationSet Wave {
+  Animation {
+    { Bone1 }
+    AnimationKey {
+      2;
+      3;
+      0;3;0.0,0.0,0.0;;,
+      10;3;1.0,0.0,0.0;;,
+      50;3;1.0,2.0,0.0;;;
+    }
+  }
+}
+)";
+  const std::string file = testing::TempDir() + "conform_zero_tps.x";
+  { std::ofstream(file) << x; }
+  const auto m = io::import_model(file);
+  ASSERT_EQ(m.animations.size(), 1u);
+  EXPECT_EQ(m.animations[0].ticks_per_second, 25.0);
+  EXPECT_DOUBLE_EQ(m.animations[0].duration(), 2.0);  // 50 ticks
+  skin::Pose pose;
+  m.animations[0].sample(m.skeleton, 0.4, skin::Blend::log, pose);  // tick 10: (1, 0, 0)
+  skin::Skinner<double> s(m.skeleton, m.mesh.rest, m.influences);
+  s.skin(pose, skin::SkinMode::cga);
+  Eigen::Matrix3Xd out;
+  s.write(out);
+  EXPECT_LT((out.colwise() - Eigen::Vector3d(1, 0, 0) - m.mesh.current).cwiseAbs().maxCoeff(),
+            1e-12);
+  m.animations[0].sample(m.skeleton, 1.2, skin::Blend::linear, pose);  // tick 30: (1, 1, 0)
+  s.skin(pose, skin::SkinMode::cga);
+  s.write(out);
+  EXPECT_LT((out.colwise() - Eigen::Vector3d(1, 1, 0) - m.mesh.current).cwiseAbs().maxCoeff(),
+            1e-12);
 }
 
 }  // namespace
