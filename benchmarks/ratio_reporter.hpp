@@ -1,5 +1,5 @@
 // A console reporter that also prints, after the run, the ratio of each benchmark's median
-// (or mean, or single) real time to its baseline's, measured in the same process.
+// (or single) CPU time to its baseline's, measured in the same process.
 //
 // Usage: register pairs with add_ratio("BM_Kernel/1024", "BM_Baseline/1024") and call
 // run_with_ratios(argc, argv) from main. With --benchmark_repetitions=N the medians are used.
@@ -33,7 +33,8 @@ class RatioReporter : public benchmark::ConsoleReporter {
     for (const auto& run : runs) {
       // Prefer the median aggregate when repetitions are used, else the single run.
       const std::string name = run.run_name.str();
-      const double t = run.GetAdjustedRealTime();
+      // CPU time: on a shared, noisy machine it is steadier than wall time for one thread.
+      const double t = run.GetAdjustedCPUTime();
       if (run.run_type == Run::RT_Aggregate) {
         if (run.aggregate_name == "median") medians_[name] = t;
       } else if (!medians_.count(name) || singles_.count(name)) {
@@ -44,7 +45,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
   }
   void Finalize() override {
     ConsoleReporter::Finalize();
-    std::printf("\nRatios (kernel time / baseline time, same run; < 1 means faster):\n");
+    std::printf("\nRatios (kernel CPU time / baseline CPU time, same run; < 1 means faster):\n");
     for (const auto& p : ratio_pairs()) {
       auto k = medians_.find(p.kernel), b = medians_.find(p.baseline);
       if (k == medians_.end() || b == medians_.end()) continue;

@@ -122,13 +122,23 @@ ProductTables build() {
         const int gk = kBladeGrade[static_cast<std::size_t>(k)];
         const ProductTerm term{static_cast<std::uint8_t>(a), static_cast<std::uint8_t>(b),
                                static_cast<std::uint8_t>(k), c};
-        t.geometric.push_back(term);
-        if (gk == ga + gb) t.outer.push_back(term);
-        if (ga <= gb && gk == gb - ga) t.left_contraction.push_back(term);
-        if (ga >= gb && gk == ga - gb) t.right_contraction.push_back(term);
-        if (gk == 0) t.scalar.push_back(term);
+        t.geometric.terms.push_back(term);
+        if (gk == ga + gb) t.outer.terms.push_back(term);
+        if (ga <= gb && gk == gb - ga) t.left_contraction.terms.push_back(term);
+        if (ga >= gb && gk == ga - gb) t.right_contraction.terms.push_back(term);
+        if (gk == 0) t.scalar.terms.push_back(term);
       }
     }
+  }
+  for (ProductTable* table :
+       {&t.geometric, &t.outer, &t.left_contraction, &t.right_contraction, &t.scalar}) {
+    // Terms were appended in increasing lhs order.
+    std::size_t k = 0;
+    for (int lhs = 0; lhs <= kBladeCount; ++lhs) {
+      while (k < table->terms.size() && table->terms[k].lhs < lhs) ++k;
+      table->lhs_begin[static_cast<std::size_t>(lhs)] = static_cast<std::uint16_t>(k);
+    }
+    table->lhs_begin[kBladeCount] = static_cast<std::uint16_t>(table->terms.size());
   }
   return t;
 }

@@ -141,10 +141,19 @@ class Multivector {
   }
 
  private:
-  static Multivector apply(const std::vector<detail::ProductTerm>& table, const Multivector& a,
+  static Multivector apply(const detail::ProductTable& table, const Multivector& a,
                            const Multivector& b) {
     Multivector r;
-    for (const auto& t : table) r.c[t.out] += static_cast<T>(t.coeff) * a.c[t.lhs] * b.c[t.rhs];
+    const detail::ProductTerm* terms = table.terms.data();
+    for (int lhs = 0; lhs < kBladeCount; ++lhs) {
+      const T x = a.c[static_cast<std::size_t>(lhs)];
+      if (x == T(0)) continue;
+      const auto end = table.lhs_begin[static_cast<std::size_t>(lhs) + 1];
+      for (auto k = table.lhs_begin[static_cast<std::size_t>(lhs)]; k < end; ++k) {
+        const detail::ProductTerm& t = terms[k];
+        r.c[t.out] += static_cast<T>(t.coeff) * x * b.c[t.rhs];
+      }
+    }
     return r;
   }
   Multivector with_grade_signs(std::array<int, 6> sign) const {
