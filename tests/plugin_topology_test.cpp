@@ -1,0 +1,242 @@
+// Topology changes applied to a live skinned soft body: survivors keep x and v exactly, new
+// nodes are interpolated, mass and momentum are conserved, every piece is its own btSoftBody
+// mirroring the mesh, and the pieces keep following the skeleton.
+#include <BulletSoftBody/btSoftBody.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include "conform/bullet/plugin.hpp"
+#include "conform/mesh/analysis.hpp"
+#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/skinner.hpp"
+#include "plugin_world.hpp"
+
+using namespace conform;
+using conform::test::SoftWorld;
+
+namespace {
+
+skin::Pose swing(const skin::Skeleton& skeleton, double shoulder, double elbow) {
+  skin::Pose pose = skin::Pose::rest(skeleton);
+  pose.apply_local(0, skin::Versor::from_trs(cga::Vec3<double>(0, 0, 0),
+                                              cga::Quat<double>(Eigen::AngleAxisd(shoulder, Eigen::Vector3d::UnitY())),
+                                              1.0));
+  pose.apply_local(1, skin::Versor::from_trs(cga::Vec3<double>(0, 0, 0),
+                                              cga::Quat<double>(Eigen::AngleAxisd(elbow, Eigen::Vector3d::UnitX())),
+                                              1.0));
+  return pose;
+}
+
+struct Snapshot {
+  std::vector<btVector3> x, v;
+  double mass = 0;
+  Eigen::Vector3d momentum;
+  double scale = 0;
+};
+
+Snapshot snapshot(const bullet::SkinnedSoftBody& body) {
+  Snapshot s;
+  for (std::int32_t i = 0; i < body.vertex_count(); ++i) {
+    const auto& node = body.body_of(i)->m_nodes[body.node_of(i)];
+    s.x.push_back(node.m_x);
+    s.v.push_back(node.m_v);
+  }
+  s.mass = body.total_mass();
+  s.momentum = body.momentum();
+  s.scale = body.momentum_scale();
+  return s;
+}
+
+// Survivors bit-exact, new nodes interpolated, Σm and Σm·v unchanged.
+void expect_conserved(const bullet::SkinnedSoftBody& body, const Snapshot& before,
+                      const std::vector<mesh::TopologyChange>& changes, const char* what) {
+  const auto old = static_cast<std::int32_t>(before.x.size());
+  for (std::int32_t i = 0; i < old; ++i) {
+    const auto& node = body.body_of(i)->m_nodes[body.node_of(i)];
+    ASSERT_TRUE(node.m_x == before.x[std::size_t(i)]) << what << " vertex " << i;
+    ASSERT_TRUE(node.m_v == before.v[std::size_t(i)]) << what << " vertex " << i;
+  }
+  const double eps = sizeof(btScalar) == 4 ? 1e-6 : 1e-13;
+  for (const auto& change : changes)
+    for (std::size_t k = 0; k < change.new_vertices.size(); ++k) {
+      const auto& nv = change.new_vertices[k];
+      Eigen::Vector3d x = nv.displacement, v = Eigen::Vector3d::Zero();
+      for (int j = 0; j < 3; ++j)
+        if (nv.parents[std::size_t(j)] >= 0) {
+          x += nv.coefficients[std::size_t(j)] * body.position(nv.parents[std::size_t(j)]);
+          v += nv.coefficients[std::size_t(j)] * body.velocity(nv.parents[std::size_t(j)]);
+        }
+      const std::int32_t id = change.base_vertex_count + std::int32_t(k);
+      ASSERT_LT((body.position(id) - x).norm(), eps * (1 + x.norm())) << what;
+      ASSERT_LT((body.velocity(id) - v).norm(), eps * (1 + v.norm())) << what;
+    }
+  EXPECT_NEAR(body.total_mass(), before.mass, 1e-9 * before.mass) << what;
+  EXPECT_LT((body.momentum() - before.momentum).norm(), 1e-9 * before.scale) << what;
+  EXPECT_GT(before.scale, 0) << what;  // a moving body: the momentum check means something
+}
+
+// Every Bullet piece mirrors the mesh: the same faces, one link per edge with our rest length,
+// one node per vertex, faces of a piece connected, pieces = the mesh's connected pieces.
+void expect_mirrors_mesh(const bullet::SkinnedSoftBody& body, const char* what) {
+  const auto& m = body.mesh();
+  std::multiset<std::array<std::int32_t, 3>> mesh_faces, bullet_faces;
+  auto canonical = [](std::array<std::int32_t, 3> f) {
+    std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
+    return f;
+  };
+  for (const auto& f : m.faces) mesh_faces.insert(canonical({f[0], f[1], f[2]}));
+  std::set<std::pair<std::int32_t, std::int32_t>> mesh_edges;
+  for (const auto& f : m.faces)
+    for (int k = 0; k < 3; ++k)
+      mesh_edges.insert(std::minmax(f[std::size_t(k)], f[std::size_t((k + 1) % 3)]));
+  std::vector<int> seen(std::size_t(m.vertex_count()), 0);
+  std::size_t links = 0;
+  for (btSoftBody* sb : body.pieces()) {
+    auto vertex = [&](const btSoftBody::Node* n) { return body.vertex_of(sb, int(n - &sb->m_nodes[0])); };
+    for (int i = 0; i < sb->m_nodes.size(); ++i) ++seen[std::size_t(body.vertex_of(sb, i))];
+    // Faces connected through shared nodes (a union-find over this body's nodes).
+    std::vector<int> parent(std::size_t(sb->m_nodes.size()));
+    for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = int(i);
+    auto find = [&](int a) {
+      while (parent[std::size_t(a)] != a) a = parent[std::size_t(a)] = parent[std::size_t(parent[std::size_t(a)])];
+      return a;
+    };
+    std::set<int> with_faces;
+    for (int i = 0; i < sb->m_faces.size(); ++i) {
+      const auto& f = sb->m_faces[i];
+      bullet_faces.insert(canonical({vertex(f.m_n[0]), vertex(f.m_n[1]), vertex(f.m_n[2])}));
+      for (int k = 0; k < 3; ++k) {
+        const int a = int(f.m_n[k] - &sb->m_nodes[0]), b = int(f.m_n[(k + 1) % 3] - &sb->m_nodes[0]);
+        parent[std::size_t(find(a))] = find(b);
+        with_faces.insert(a);
+      }
+    }
+    std::set<int> roots;
+    for (const int a : with_faces) roots.insert(find(a));
+    EXPECT_LE(roots.size(), 1u) << what << ": a btSoftBody holds faces of several pieces";
+    for (int i = 0; i < sb->m_links.size(); ++i) {
+      const auto& l = sb->m_links[i];
+      const std::int32_t a = vertex(l.m_n[0]), b = vertex(l.m_n[1]);
+      const std::pair<std::int32_t, std::int32_t> e = std::minmax(a, b);
+      ASSERT_TRUE(mesh_edges.count(e)) << what << ": link without a face";
+      ASSERT_NEAR(double(l.m_rl), body.rest_length(e.first, e.second), 1e-6 * double(l.m_rl) + 1e-12);
+      ++links;
+    }
+  }
+  EXPECT_EQ(mesh_faces.size(), bullet_faces.size()) << what;
+  std::vector<std::array<std::int32_t, 3>> only_mesh, only_bullet;
+  std::set_difference(mesh_faces.begin(), mesh_faces.end(), bullet_faces.begin(), bullet_faces.end(),
+                      std::back_inserter(only_mesh));
+  std::set_difference(bullet_faces.begin(), bullet_faces.end(), mesh_faces.begin(), mesh_faces.end(),
+                      std::back_inserter(only_bullet));
+  EXPECT_TRUE(only_mesh.empty() && only_bullet.empty())
+      << what << ": " << only_mesh.size() << " faces only in the mesh, " << only_bullet.size()
+      << " only in Bullet";
+  EXPECT_EQ(links, mesh_edges.size()) << what;
+  for (std::size_t v = 0; v < seen.size(); ++v) ASSERT_EQ(seen[v], 1) << what << " vertex " << v;
+  EXPECT_EQ(body.piece_count(), mesh::label_pieces(m).count) << what;
+}
+
+struct LiveArm {
+  SoftWorld w;
+  bullet::Plugin plugin{w.world};
+  mesh::Arm arm = mesh::make_arm(1);
+  bullet::SkinnedSoftBody* body = nullptr;
+  skin::PoseTrack track;
+  LiveArm() {
+    body = &plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = 0.1});
+    track.set_key(0, skin::Pose::rest(arm.skeleton));
+    track.set_key(2, swing(arm.skeleton, 0.8, 1.2));
+    body->set_keyframes(track);
+    w.step(20);  // moving: every node has a velocity
+  }
+};
+
+}  // namespace
+
+TEST(PluginTopology, CutSplitsTheArmIntoTwoLiveBodies) {
+  LiveArm a;
+  auto& body = *a.body;
+  const Snapshot before = snapshot(body);
+  const auto result = body.cut(cga::Plane<double>::from_normal_point({0, 0, 1}, {0, 0, 0.42}));
+  ASSERT_EQ(result.status, mesh::CutStatus::Cut);
+  expect_conserved(body, before, {result.change}, "cut");
+  expect_mirrors_mesh(body, "cut");
+  EXPECT_EQ(body.piece_count(), 2);
+  EXPECT_EQ(a.w.world.getSoftBodyArray().size(), 2);
+  EXPECT_GT(body.last_apply().moved_nodes, 0);
+  EXPECT_EQ(body.last_apply().new_pieces, 1);
+  // Both pieces keep following the skeleton: kinematic nodes sit on targets skinned from the
+  // mesh's updated rest positions and weights.
+  a.w.step(30);
+  skin::Pose pose = skin::Pose::rest(a.arm.skeleton);
+  a.track.sample(a.plugin.time(), skin::Blend::linear, pose);
+  skin::Skinner<double> skinner(a.arm.skeleton, body.mesh().rest,
+                                skin::InfluenceLists::from_mesh(body.mesh()));
+  skinner.skin(pose, skin::SkinMode::cga);
+  Eigen::Matrix3Xd expected;
+  skinner.write(expected);
+  int forearm_kinematic = 0;
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v) {
+    ASSERT_LT((body.target(v) - expected.col(v)).norm(), 1e-12);
+    if (!body.kinematic(v)) continue;
+    ASSERT_LT((body.position(v) - expected.col(v)).norm(), sizeof(btScalar) == 4 ? 1e-6 : 1e-13);
+    forearm_kinematic += body.mesh().rest(2, v) > 0.42;
+  }
+  EXPECT_GT(forearm_kinematic, 100);
+}
+
+TEST(PluginTopology, TearStepsEditInPlace) {
+  LiveArm a;
+  auto& body = *a.body;
+  body.begin_tear();
+  int extended = 0;
+  for (int i = 0; i <= 20; ++i) {
+    const double z = 0.08 + 0.005 * i;
+    const Snapshot before = snapshot(body);
+    const auto step = body.tear_advance({double(i), {0, 0, z}, {0.15, 0, z}});
+    extended += step.extended;
+    expect_conserved(body, before, step.changes, "tear step");
+    // A tear step never splits the arm: only local edits, no node moves between bodies.
+    EXPECT_EQ(body.last_apply().moved_nodes, 0);
+    EXPECT_EQ(body.last_apply().new_pieces, 0);
+    a.w.step();
+  }
+  EXPECT_GT(extended, 10) << body.tear()->message();
+  expect_mirrors_mesh(body, "tear");
+  EXPECT_EQ(body.piece_count(), 1);
+}
+
+TEST(PluginTopology, DrillKeepsTheHolesNodesAndMass) {
+  LiveArm a;
+  auto& body = *a.body;
+  const Snapshot before = snapshot(body);
+  // Through both walls of the upper arm, at its current (posed) place.
+  const Eigen::Vector3d c = body.position(1 + 40 * 32) * 0 + [&] {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+      if (std::abs(a.arm.mesh.rest(2, v) - 0.15) < 0.01) mean += body.position(v), ++n;
+    return Eigen::Vector3d(mean / n);
+  }();
+  const auto result = body.drill({c + Eigen::Vector3d(0, 0.2, 0), c - Eigen::Vector3d(0, 0.2, 0), 0.012});
+  ASSERT_EQ(result.holes, 2) << result.message;
+  expect_conserved(body, before, result.changes, "drill");
+  expect_mirrors_mesh(body, "drill");
+  EXPECT_EQ(body.piece_count(), 1);
+  a.w.step(30);
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+    ASSERT_TRUE(body.position(v).allFinite() && body.velocity(v).allFinite());
+}
+
+TEST(PluginTopology, ApplyRejectsAChangeForAnotherMesh) {
+  LiveArm a;
+  mesh::TopologyChange change;
+  change.base_vertex_count = a.body->vertex_count() + 1;
+  change.base_face_count = a.body->mesh().face_count();
+  EXPECT_THROW(a.body->apply(change), std::invalid_argument);
+  expect_mirrors_mesh(*a.body, "rejected");
+}
