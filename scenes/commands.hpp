@@ -4,6 +4,8 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
 
 namespace conform::cli {
 
@@ -11,9 +13,17 @@ struct Context {
   int exit_code = 0;
 };
 
-void register_info(CLI::App& app, Context& context);   // cmd_info.cpp   (issue 3 extends)
-void register_ik(CLI::App& app, Context& context);     // cmd_ik.cpp     (issue 4)
-void register_skin(CLI::App& app, Context& context);   // cmd_skin.cpp   (issue 3)
+void register_info(CLI::App& app, Context& context);      // cmd_info.cpp   (issue 3 extends)
+void register_ik(CLI::App& app, Context& context);        // cmd_ik.cpp     (issue 4)
+void register_skin(CLI::App& app, Context& context);      // cmd_skin.cpp   (issue 3)
 void register_mesh_ops(CLI::App& app, Context& context);  // cmd_mesh_ops.cpp (issue 5)
+void register_run(CLI::App& app, Context& context);       // cmd_run.cpp    (issue 7)
+void register_scenes(CLI::App& app, Context& context);    // cmd_run.cpp    (issue 7)
+
+/// The scene `conform` runs when given no arguments.
+const char* default_scene();
+/// Runs a scene (built-in name or file) into `out_dir` (empty: results/NAME); the exit code.
+int run_scene(const std::string& scene, const std::string& out_dir, int steps,
+              const std::vector<std::string>& sets);
 
 }  // namespace conform::cli

@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   conform::cli::register_ik(app, context);
   conform::cli::register_skin(app, context);
   conform::cli::register_mesh_ops(app, context);
+  conform::cli::register_run(app, context);
+  conform::cli::register_scenes(app, context);
   app.require_subcommand(0, 1);
   try {
     app.parse(argc, argv);
@@ -19,8 +21,11 @@ int main(int argc, char** argv) {
     return app.exit(e);
   }
   if (app.get_subcommands().empty()) {
-    std::cout << "conform " << conform::version() << "\n" << app.help() << std::flush;
-    return 0;
+    // The main job: the default scene into results/NAME (see `conform --help` for the rest).
+    std::cout << "conform " << conform::version() << ": no command given, running the default "
+              << "scene '" << conform::cli::default_scene()
+              << "' (conform --help lists commands)\n";
+    return conform::cli::run_scene(conform::cli::default_scene(), "", 0, {});
   }
   return context.exit_code;
 }

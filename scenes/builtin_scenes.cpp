@@ -1,0 +1,88 @@
+// The built-in scenes: scene files compiled into the command, so `conform run NAME` needs no
+// file. `conform scenes --show NAME` prints one to start a scene file of your own from.
+#include <fstream>
+#include <sstream>
+
+#include "scene.hpp"
+
+namespace conform::scenes {
+
+const std::vector<SceneKind>& scene_kinds() {
+  static const std::vector<SceneKind> kinds = {
+      {"arm-track", &make_arm_track},
+  };
+  return kinds;
+}
+
+const std::vector<BuiltinScene>& builtin_scenes() {
+  static const std::vector<BuiltinScene> scenes = {
+      {"arm-track",
+       "btMultiBody arm driven by CGA IK along a figure-eight and random waypoints, skin by CGA "
+       "skinning; tracking error with/without gravity compensation",
+       R"json({
+  "scene": "arm-track",
+  "description": "A btMultiBody arm (spherical shoulder, revolute elbow; upper arm 0.30 m, forearm 0.25 m) whose torque-limited joint motors follow the closed-form CGA IK solution for a figure-eight and then random waypoints; the procedural arm's skin follows the physical bones through CGA skinning. Runs with and without gravity compensation on the same targets.",
+  "seed": 7,
+  "model": { "resolution": 1 },
+  "arm": {
+    "upper_mass": 2.0, "fore_mass": 1.5, "fore_com": 0.14,
+    "shoulder_max_torque": 8, "elbow_max_torque": 4,
+    "kp": 0.5, "swivel": 0.0, "gravity_compensation": "both"
+  },
+  "targets": {
+    "center": [0.0, -0.25, 0.30],
+    "figure_eight": { "width": 0.30, "height": 0.15, "period": 4, "duration": 8 },
+    "waypoints": { "count": 6, "move": 0.8, "hold": 0.8,
+                   "min_radius": 0.28, "max_radius": 0.50, "cone_deg": 30 }
+  },
+  "physics": { "dt": 0.016666666666666666, "substeps": 4, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 60, "plots": true }
+})json"},
+  };
+  return scenes;
+}
+
+const BuiltinScene* find_builtin(const std::string& name) {
+  for (const auto& s : builtin_scenes())
+    if (name == s.name) return &s;
+  return nullptr;
+}
+
+std::unique_ptr<Scene> load_scene(const std::string& name_or_file,
+                                  const std::vector<std::string>& assignments, int steps_override) {
+  Json scene;
+  std::string name;
+  if (const BuiltinScene* b = find_builtin(name_or_file)) {
+    scene = Json::parse(b->json);
+    name = b->name;
+  } else {
+    std::ifstream in(name_or_file);
+    if (!in) {
+      std::string names;
+      for (const auto& s : builtin_scenes())
+        names += (names.empty() ? "" : ", ") + std::string(s.name);
+      throw std::runtime_error("'" + name_or_file + "' is neither a built-in scene (" + names +
+                               ") nor a readable scene file");
+    }
+    try {
+      scene = Json::parse(in, nullptr, true, /*ignore_comments=*/true);
+    } catch (const Json::parse_error& e) {
+      throw std::runtime_error(name_or_file + ": not valid JSON: " + e.what());
+    }
+    name = std::filesystem::path(name_or_file).stem().string();
+  }
+  for (const auto& a : assignments) apply_set(scene, a);
+  if (!scene.is_object()) throw SceneError("(scene)", show(scene), "must be a JSON object");
+  const auto it = scene.find("scene");
+  if (it == scene.end()) throw SceneError("scene", "(missing)", "is required: the scene kind");
+  std::string kinds;
+  for (const auto& k : scene_kinds()) {
+    if (it->is_string() && it->get<std::string>() == k.name)
+      return k.factory(scene, name, steps_override);
+    kinds += (kinds.empty() ? "" : ", ") + std::string(k.name);
+  }
+  throw SceneError("scene", show(*it), "unknown scene kind (known: " + kinds + ")");
+}
+
+}  // namespace conform::scenes

@@ -1,0 +1,117 @@
+// `conform run SCENE [--out DIR] [--steps N] [--set KEY=VALUE …]` and `conform scenes`.
+// SCENE is a built-in scene name or a JSON scene file. The scene is parsed completely before
+// anything is written, so a bad key or value leaves no folder behind.
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+
+#include "commands.hpp"
+#include "scene.hpp"
+
+namespace conform::cli {
+namespace {
+
+struct RunArgs {
+  std::string scene, out;
+  int steps = 0;
+  std::vector<std::string> sets;
+};
+
+void print_metrics(const scenes::Json& j, const std::string& prefix) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (it->is_object()) {
+      print_metrics(*it, prefix + it.key() + ".");
+    } else if (it->is_number() || it->is_boolean()) {
+      std::cout << "  " << prefix << it.key() << " = " << it->dump() << "\n";
+    }
+  }
+}
+
+}  // namespace
+
+const char* default_scene() {
+  // tear-opening is the main comparison; until its scene kind exists, the best real scene.
+  return scenes::find_builtin("tear-opening") ? "tear-opening" : "arm-track";
+}
+
+int run_scene(const std::string& scene, const std::string& out_dir, int steps,
+              const std::vector<std::string>& sets) {
+  std::unique_ptr<scenes::Scene> prepared;
+  try {
+    prepared = scenes::load_scene(scene, sets, steps);
+  } catch (const scenes::SceneError& e) {
+    std::cerr << "conform run: " << scene << ": " << e.what() << " (nothing written)\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "conform run: " << e.what() << " (nothing written)\n";
+    return 2;
+  }
+  const std::filesystem::path dir = out_dir.empty()
+                                        ? std::filesystem::path("results") / prepared->common().name
+                                        : std::filesystem::path(out_dir);
+  try {
+    const auto& c = prepared->common();
+    std::cout << "conform run " << c.name << " (" << c.kind << "): " << c.steps << " steps of "
+              << c.dt << " s, seed " << c.seed << "\n"
+              << std::flush;
+    scenes::RunOutput out(dir, c);
+    const scenes::Json metrics = prepared->run(out);
+    const scenes::Json summary =
+        scenes::Json::parse(std::ifstream(dir / "summary.json"), nullptr, false);
+    std::cout << "metrics:\n";
+    print_metrics(metrics, "");
+    if (summary.is_object()) {
+      const auto& t = summary["timings"];
+      std::cout << "timing: " << t.value("wall_per_simulated_second_s", 0.0)
+                << " s wall per simulated second, " << t.value("wall_per_step_ms", 0.0)
+                << " ms per step (" << t.value("real_time_factor", 0.0) << "x real time)\n";
+      for (auto it = summary["plots"].begin(); it != summary["plots"].end(); ++it)
+        if (it->get<std::string>().rfind("not drawn", 0) == 0)
+          std::cout << "plot " << it.key() << ": " << it->get<std::string>() << "\n";
+    }
+    std::cout << "results in " << std::filesystem::absolute(dir).lexically_normal().string()
+              << "/ (summary.json, metrics.csv, frames/*.ply, *.png)\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "conform run: " << prepared->common().name << ": " << e.what() << "\n";
+    return 1;
+  }
+}
+
+void register_run(CLI::App& app, Context& context) {
+  auto* cmd = app.add_subcommand("run", "Run a scene headless and write its results to a folder");
+  auto args = std::make_shared<RunArgs>();
+  cmd->add_option("SCENE", args->scene, "built-in scene name (see `conform scenes`) or JSON file")
+      ->required();
+  cmd->add_option("--out", args->out, "output folder (default: results/SCENE)");
+  cmd->add_option("--steps", args->steps, "number of steps (default: the scene's duration / dt)")
+      ->check(CLI::Range(1, 100000000));
+  cmd->add_option("--set", args->sets, "override a scene key, e.g. --set physics.dt=0.005")
+      ->allow_extra_args(false);
+  cmd->callback([&context, args]() {
+    context.exit_code = run_scene(args->scene, args->out, args->steps, args->sets);
+  });
+}
+
+void register_scenes(CLI::App& app, Context& context) {
+  auto* cmd = app.add_subcommand("scenes", "List the built-in scenes (or print one's JSON)");
+  auto show = std::make_shared<std::string>();
+  cmd->add_option("--show", *show, "print the scene file of a built-in scene");
+  cmd->callback([&context, show]() {
+    if (!show->empty()) {
+      const auto* b = scenes::find_builtin(*show);
+      if (!b) {
+        std::cerr << "conform scenes: no built-in scene '" << *show << "'\n";
+        context.exit_code = 2;
+        return;
+      }
+      std::cout << b->json << "\n";
+      return;
+    }
+    for (const auto& s : scenes::builtin_scenes())
+      std::cout << std::left << std::setw(14) << s.name << " " << s.summary << "\n";
+  });
+}
+
+}  // namespace conform::cli

@@ -1,0 +1,205 @@
+#include "run_output.hpp"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+
+#include "conform/bullet/convert.hpp"
+#include "conform/io/mesh_export.hpp"
+#include "conform/version.hpp"
+
+namespace conform::scenes {
+
+namespace fs = std::filesystem;
+
+CommonSettings read_common(Reader& root, const std::string& name, double default_duration,
+                           int steps_override) {
+  CommonSettings c;
+  c.name = name;
+  c.kind = root.text("scene", "");
+  root.text("description", "");
+  c.seed = static_cast<std::uint64_t>(root.integer("seed", 1, 0, 2147483647));
+  const double duration = root.number("duration", default_duration, 1e-6, 1e5);
+  Reader physics = root.object("physics");
+  c.dt = physics.number("dt", c.dt, 1e-5, 0.1);
+  c.substeps = physics.integer("substeps", c.substeps, 1, 1000);
+  c.solver_iterations = physics.integer("solver_iterations", c.solver_iterations, 1, 1000);
+  c.gravity = physics.vec3("gravity", c.gravity);
+  // Physics keys a scene kind may read later stay unread here; the kind finishes the object.
+  physics.finish();
+  Reader outputs = root.object("outputs");
+  c.metrics_every = outputs.integer("metrics_every", 1, 1, 1000000);
+  c.frames_every = outputs.integer("frames_every", 0, 0, 1000000);
+  c.plots = outputs.boolean("plots", true);
+  outputs.finish();
+  c.steps = steps_override > 0 ? steps_override
+                               : std::max(1, static_cast<int>(std::lround(duration / c.dt)));
+  return c;
+}
+
+RunOutput::Csv::Csv(const fs::path& path, std::vector<std::string> columns)
+    : out_(path), columns_(std::move(columns)) {
+  if (!out_) throw std::runtime_error("cannot write " + path.string());
+  for (std::size_t i = 0; i < columns_.size(); ++i) out_ << (i ? "," : "") << columns_[i];
+  out_ << "\n";
+}
+
+void RunOutput::Csv::row(std::span<const double> values) {
+  if (values.size() != columns_.size())
+    throw std::logic_error("metrics row has " + std::to_string(values.size()) + " values, not " +
+                           std::to_string(columns_.size()));
+  char buf[32];
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    // %.9g keeps the file deterministic and exact enough to compare runs.
+    std::snprintf(buf, sizeof buf, "%.9g", values[i]);
+    out_ << (i ? "," : "") << buf;
+  }
+  out_ << "\n";
+}
+
+RunOutput::RunOutput(fs::path dir, const CommonSettings& common)
+    : dir_(std::move(dir)), common_(common), start_(Clock::now()) {
+  std::error_code ec;
+  fs::create_directories(dir_ / "frames", ec);
+  if (ec)
+    throw std::runtime_error("cannot create " + (dir_ / "frames").string() + ": " + ec.message());
+  tty_ = ::isatty(STDERR_FILENO) == 1;
+}
+
+void RunOutput::open_metrics(std::vector<std::string> columns) {
+  metrics_ = std::make_unique<Csv>(dir_ / "metrics.csv", std::move(columns));
+}
+
+RunOutput::Csv RunOutput::open_csv(const std::string& file, std::vector<std::string> columns) {
+  return Csv(dir_ / file, std::move(columns));
+}
+
+void RunOutput::frame(const std::string& name, int step, const mesh::SkinnedMesh& mesh,
+                      std::span<const std::int32_t> faces) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "_%06d.ply", step);
+  io::write_mesh(dir_ / "frames" / (name + buf), mesh, {}, faces);
+  ++frames_;
+}
+
+void RunOutput::progress(int step, int steps) {
+  if (!tty_) return;
+  const int percent = steps > 0 ? (100 * step) / steps : 100;
+  if (percent == last_percent_) return;
+  last_percent_ = percent;
+  const int width = 40, filled = width * percent / 100;
+  std::cerr << "\r" << common_.name << " [" << std::string(static_cast<std::size_t>(filled), '#')
+            << std::string(static_cast<std::size_t>(width - filled), '.') << "] " << percent << "%"
+            << (step >= steps ? "\n" : "") << std::flush;
+}
+
+namespace {
+
+std::string quote(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+void write_axes(std::ostream& gp, const Plot& p) {
+  gp << "set title " << quote(p.title) << "\n"
+     << "set xlabel " << quote(p.xlabel) << "\n"
+     << "set ylabel " << quote(p.ylabel) << "\n"
+     << "plot ";
+  for (std::size_t i = 0; i < p.series.size(); ++i) {
+    const auto& s = p.series[i];
+    gp << (i ? ", \\\n     " : "") << quote(s.file) << " using " << quote(s.x) << ":" << quote(s.y)
+       << " with " << s.style << " lw 2 title " << quote(s.title);
+  }
+  gp << "\n";
+}
+
+}  // namespace
+
+bool RunOutput::draw(const Plot& plot, std::string& problem) const {
+  const fs::path script = dir_ / (plot.name + ".gp");
+  {
+    std::ofstream gp(script);
+    if (!gp) {
+      problem = "cannot write " + script.string();
+      return false;
+    }
+    const int panels = std::max<int>(1, static_cast<int>(plot.panels.size()));
+    gp << "# Drawn by conform from the CSV files beside it: gnuplot " << plot.name << ".gp\n"
+       << "set terminal pngcairo size " << (panels > 1 ? 600 * panels : 1000)
+       << ",600 enhanced font 'sans,11'\n"
+       << "set output " << quote(plot.name + ".png") << "\n"
+       << "set datafile separator ','\n"
+       << "set grid\nset key top left\n";
+    if (plot.panels.empty()) {
+      write_axes(gp, plot);
+    } else {
+      gp << "set multiplot layout 1," << panels << " title " << quote(plot.title) << "\n";
+      for (const auto& p : plot.panels) write_axes(gp, p);
+      gp << "unset multiplot\n";
+    }
+  }
+  const std::string cmd = "cd " + quote(dir_.string()) + " && gnuplot " + quote(plot.name + ".gp") +
+                          " > " + quote(plot.name + ".log") + " 2>&1";
+  const int rc = std::system(cmd.c_str());
+  if (rc != 0) {
+    problem = "gnuplot failed (see " + (dir_ / (plot.name + ".log")).string() + ")";
+    return false;
+  }
+  fs::remove(dir_ / (plot.name + ".log"));
+  return true;
+}
+
+fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int steps,
+                           double simulated_seconds, double loop_seconds) {
+  metrics_.reset();  // flush metrics.csv before gnuplot reads it
+  const double wall = std::chrono::duration<double>(Clock::now() - start_).count();
+  Json plots = Json::object();
+  if (common_.plots) {
+    const bool have_gnuplot = std::system("command -v gnuplot > /dev/null 2>&1") == 0;
+    for (const auto& p : plots_) {
+      std::string problem = "gnuplot is not installed (scripts/deps.sh installs gnuplot-nox)";
+      if (have_gnuplot && draw(p, problem))
+        plots[p.name] = p.name + ".png";
+      else
+        plots[p.name] = "not drawn: " + problem;
+    }
+  }
+  Json summary;
+  summary["scene"] = common_.name;
+  summary["kind"] = common_.kind;
+  summary["version"] = conform::version();
+  summary["bullet_precision"] = bullet::bullet_precision();
+  summary["seed"] = common_.seed;
+  summary["settings"] = settings;
+  // The per-second and per-step figures are of the stepping loop (physics, skinning, topology,
+  // metrics, frames); wall_s also counts loading, setup and plotting.
+  timings["wall_s"] = wall;
+  timings["loop_s"] = loop_seconds;
+  timings["steps"] = steps;
+  timings["simulated_s"] = simulated_seconds;
+  timings["wall_per_simulated_second_s"] =
+      simulated_seconds > 0 ? loop_seconds / simulated_seconds : 0.0;
+  timings["wall_per_step_ms"] = steps > 0 ? 1e3 * loop_seconds / steps : 0.0;
+  timings["real_time_factor"] = loop_seconds > 0 ? simulated_seconds / loop_seconds : 0.0;
+  summary["timings"] = timings;
+  summary["metrics"] = metrics;
+  summary["frames"] = frames_;
+  summary["plots"] = plots;
+  const fs::path path = dir_ / "summary.json", tmp = dir_ / ".summary.json.tmp";
+  {
+    std::ofstream out(tmp);
+    out << summary.dump(2) << "\n";
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+  }
+  fs::rename(tmp, path);
+  return path;
+}
+
+}  // namespace conform::scenes

@@ -1,0 +1,108 @@
+// What a scene run writes into its folder: metrics.csv (a time series), summary.json (settings,
+// version, timings, final metrics), frames (PLY) and PNG plots drawn by gnuplot from the CSV.
+// The folder is created only when the run starts, i.e. after the scene parsed.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "conform/mesh/skinned_mesh.hpp"
+#include "scene_config.hpp"
+
+namespace conform::scenes {
+
+/// One line of a gnuplot figure: a CSV column against another.
+struct PlotSeries {
+  std::string file = "metrics.csv";  // relative to the run folder
+  std::string x, y;                  // column names
+  std::string title;
+  std::string style = "lines";
+};
+
+struct Plot {
+  std::string name;  // file stem: NAME.png (and NAME.gp, the script that drew it)
+  std::string title, xlabel, ylabel;
+  std::vector<PlotSeries> series;
+  /// Several panels side by side (multiplot), each with its own series; overrides `series`.
+  std::vector<Plot> panels;
+};
+
+/// Common settings every scene reads (physics, outputs, seed, length).
+struct CommonSettings {
+  std::string name;  // scene name (built-in name or file stem)
+  std::string kind;  // the scene's "scene" key
+  std::uint64_t seed = 1;
+  double dt = 1.0 / 60.0;  // one step, s
+  int substeps = 4;        // internal substeps per step
+  int solver_iterations = 10;
+  Eigen::Vector3d gravity{0, -9.81, 0};
+  int steps = 0;          // total steps (duration / dt, or --steps)
+  int metrics_every = 1;  // steps between metric rows
+  int frames_every = 0;   // steps between PLY frames (0: first and last only)
+  bool plots = true;
+};
+
+class RunOutput {
+ public:
+  using Clock = std::chrono::steady_clock;
+
+  /// Creates `dir` (and dir/frames). Throws std::runtime_error when it cannot.
+  RunOutput(std::filesystem::path dir, const CommonSettings& common);
+
+  const std::filesystem::path& dir() const { return dir_; }
+
+  /// A CSV file in the run folder with the given header; rows are appended with row().
+  class Csv {
+   public:
+    Csv(const std::filesystem::path& path, std::vector<std::string> columns);
+    void row(std::span<const double> values);
+    std::size_t columns() const { return columns_.size(); }
+
+   private:
+    std::ofstream out_;
+    std::vector<std::string> columns_;
+  };
+  Csv& metrics() { return *metrics_; }
+  void open_metrics(std::vector<std::string> columns);
+  Csv open_csv(const std::string& file, std::vector<std::string> columns);
+
+  /// Writes frames/NAME_STEP.ply (positions of `mesh`, all faces or `faces`).
+  void frame(const std::string& name, int step, const mesh::SkinnedMesh& mesh,
+             std::span<const std::int32_t> faces = {});
+  int frames_written() const { return frames_; }
+
+  /// Progress on stderr, only when it is a terminal.
+  void progress(int step, int steps);
+
+  void add_plot(Plot plot) { plots_.push_back(std::move(plot)); }
+
+  /// Draws the plots, writes summary.json (atomically) and returns its path. `settings` is the
+  /// resolved scene, `metrics` the final metrics, `timings` extra timing entries; the wall time
+  /// per simulated second and per step (of the stepping loop, `loop_seconds` long) are added.
+  std::filesystem::path finish(const Json& settings, Json metrics, Json timings, int steps,
+                               double simulated_seconds, double loop_seconds);
+
+ private:
+  bool draw(const Plot& plot, std::string& problem) const;
+
+  std::filesystem::path dir_;
+  CommonSettings common_;
+  Clock::time_point start_;
+  std::unique_ptr<Csv> metrics_;
+  std::vector<Plot> plots_;
+  int frames_ = 0;
+  bool tty_ = false;
+  int last_percent_ = -1;
+};
+
+/// Reads the common keys (scene, seed, duration, physics, outputs) of a scene object.
+CommonSettings read_common(Reader& root, const std::string& name, double default_duration,
+                           int steps_override);
+
+}  // namespace conform::scenes
