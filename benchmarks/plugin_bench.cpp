@@ -1,0 +1,190 @@
+// The Bullet plugin: one physics step of the skinned arm (default resolution) with CGA
+// skinning against the same soft body without skinning; the time to apply a cut, a tear step
+// and a drill to a live arm; and steps per second of a tear that opens.
+#include <BulletSoftBody/btSoftBody.h>
+#include <benchmark/benchmark.h>
+
+#include <memory>
+
+#include "../tests/plugin_world.hpp"
+#include "conform/bullet/plugin.hpp"
+#include "conform/mesh/primitives.hpp"
+#include "conform/mesh/procedural_arm.hpp"
+#include "ratio_reporter.hpp"
+
+using namespace conform;
+using conform::test::SoftWorld;
+
+namespace {
+
+const mesh::Arm& the_arm() {
+  static const mesh::Arm arm = mesh::make_arm(1);
+  return arm;
+}
+
+skin::Pose bent(const skin::Skeleton& skeleton, double shoulder, double elbow) {
+  skin::Pose pose = skin::Pose::rest(skeleton);
+  pose.apply_local(
+      0, skin::Versor::from_trs(
+             cga::Vec3<double>(0, 0, 0),
+             cga::Quat<double>(Eigen::AngleAxisd(shoulder, Eigen::Vector3d::UnitY())), 1.0));
+  pose.apply_local(1,
+                   skin::Versor::from_trs(
+                       cga::Vec3<double>(0, 0, 0),
+                       cga::Quat<double>(Eigen::AngleAxisd(elbow, Eigen::Vector3d::UnitX())), 1.0));
+  return pose;
+}
+
+struct LiveArm {
+  SoftWorld w;
+  bullet::Plugin plugin{w.world};
+  bullet::SkinnedSoftBody* body;
+  explicit LiveArm(int warmup = 10) {
+    const auto& arm = the_arm();
+    body = &plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = 0.05});
+    skin::PoseTrack track;
+    track.set_key(0, skin::Pose::rest(arm.skeleton));
+    track.set_key(1, bent(arm.skeleton, 0.7, 1.2));
+    track.set_key(2, skin::Pose::rest(arm.skeleton));
+    body->set_keyframes(track);
+    w.step(warmup);
+  }
+};
+
+void BM_StepSkinned(benchmark::State& state) {
+  LiveArm a;
+  for (auto _ : state) a.w.step();
+  state.counters["nodes"] = a.body->vertex_count();
+}
+BENCHMARK(BM_StepSkinned)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+// The same pieces (nodes, links, faces, masses, kinematic nodes with inverse mass 0) built by
+// SkinnedSoftBody but never driven: no action, no skinning, no rest-length re-application.
+void BM_StepUnskinned(benchmark::State& state) {
+  SoftWorld w;
+  const auto& arm = the_arm();
+  bullet::SkinnedSoftBody body(
+      w.world.getWorldInfo(), [&](btSoftBody* b) { w.world.addSoftBody(b); },
+      [&](btSoftBody* b) { w.world.removeSoftBody(b); }, arm.mesh, arm.skeleton,
+      {.pretension = 0.05});
+  w.step(10);
+  for (auto _ : state) w.step();
+  state.counters["nodes"] = body.vertex_count();
+}
+BENCHMARK(BM_StepUnskinned)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+// Skinning alone (pose, per-bone kernels, eq 17 vertex loop) for one substep.
+void BM_SkinTargets(benchmark::State& state) {
+  LiveArm a(1);
+  double t = 0;
+  for (auto _ : state) a.body->skin_targets(t += 1e-3);
+}
+BENCHMARK(BM_SkinTargets)->Unit(benchmark::kMicrosecond);
+
+// A plane across the forearm of a live arm: compute the cut on the simulated positions, apply
+// it to the mesh and to Bullet (the arm splits into two bodies).
+void BM_CutLiveArm(benchmark::State& state) {
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto a = std::make_unique<LiveArm>();
+    state.ResumeTiming();
+    a->body->cut(cga::Plane<double>::from_normal_point({0.1, 0, 1}, {0, 0, 0.42}));
+    state.PauseTiming();
+    a.reset();
+    state.ResumeTiming();
+  }
+}
+BENCHMARK(BM_CutLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(3);
+
+// Only the application of an already computed cut (mesh + Bullet mirror).
+void BM_ApplyCutLiveArm(benchmark::State& state) {
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto a = std::make_unique<LiveArm>();
+    a->body->sync_mesh();
+    const auto result = mesh::compute_cut(
+        a->body->mesh(), cga::Plane<double>::from_normal_point({0.1, 0, 1}, {0, 0, 0.42}));
+    state.ResumeTiming();
+    a->body->apply(result.change);
+    state.PauseTiming();
+    a.reset();
+    state.ResumeTiming();
+  }
+}
+BENCHMARK(BM_ApplyCutLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(3);
+
+// One tear step (a blade sample advancing an open tear on the upper arm), compute + apply.
+void BM_TearStepLiveArm(benchmark::State& state) {
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto a = std::make_unique<LiveArm>();
+    a->body->begin_tear();
+    for (int i = 0; i < 6; ++i) {
+      const double z = 0.08 + 0.006 * i;
+      a->body->tear_advance({double(i), {0, 0, z}, {0.15, 0, z}});
+    }
+    a->w.step();
+    state.ResumeTiming();
+    a->body->tear_advance({6.0, {0, 0, 0.116}, {0.15, 0, 0.116}});
+    state.PauseTiming();
+    a.reset();
+    state.ResumeTiming();
+  }
+}
+BENCHMARK(BM_TearStepLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(3);
+
+// A 1 cm drill through both walls of the upper arm, compute + apply.
+void BM_DrillLiveArm(benchmark::State& state) {
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto a = std::make_unique<LiveArm>(1);
+    const Eigen::Vector3d c(0, 0, 0.15);
+    state.ResumeTiming();
+    a->body->drill({c + Eigen::Vector3d(0, 0.2, 0), c - Eigen::Vector3d(0, 0.2, 0), 0.01});
+    state.PauseTiming();
+    a.reset();
+    state.ResumeTiming();
+  }
+}
+BENCHMARK(BM_DrillLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(3);
+
+// Steps per second of a torn, pre-tensioned 40×40 patch while it opens.
+void BM_OpeningTearStep(benchmark::State& state) {
+  SoftWorld w;
+  bullet::Plugin plugin(w.world);
+  mesh::SkinnedMesh m = mesh::make_sheet(40, 40, 1.0, 1.0);
+  m.bones.setZero();
+  m.weights.setZero();
+  m.weights.row(0).setOnes();
+  skin::Skeleton s;
+  s.joints.push_back({"root", -1, skin::Versor::identity()});
+  s.bones.push_back({"root", 0, skin::Versor::identity()});
+  auto& body = plugin.add_skinned_body(m, s,
+                                       {.damping = 0.05,
+                                        .pretension = 0.1,
+                                        .target_stiffness = 0,
+                                        .target_damping = 0,
+                                        .kinematic_weight = 2,
+                                        .position_iterations = 10});
+  std::vector<std::int32_t> border;
+  for (std::int32_t v = 0; v < m.vertex_count(); ++v)
+    if (std::abs(m.rest(0, v)) > 0.5 - 1e-9 || std::abs(m.rest(1, v)) > 0.5 - 1e-9)
+      border.push_back(v);
+  body.set_pinned(border);
+  body.begin_tear();
+  for (int i = 0; i < 60; ++i) {
+    const double x = -0.25 + 0.5 * i / 59;
+    body.tear_advance({double(i), {x, 0.0123, -0.1}, {x, 0.0123, 0.1}});
+  }
+  for (auto _ : state) w.step();
+  state.SetItemsProcessed(state.iterations());
+  state.counters["nodes"] = body.vertex_count();
+}
+BENCHMARK(BM_OpeningTearStep)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  conform::bench::add_ratio("BM_StepSkinned", "BM_StepUnskinned", "skinned / unskinned step");
+  return conform::bench::run_with_ratios(argc, argv);
+}
