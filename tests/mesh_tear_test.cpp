@@ -47,8 +47,10 @@ void expect_torn(const SkinnedMesh& m, const SkinnedMesh& in, const Tear& tear,
       EXPECT_TRUE((h1 >= 0) != (h2 >= 0)) << what << " border edge " << i;
     }
   }
-  for (Eigen::Index v = 0; v < m.weights.cols(); ++v)
-    ASSERT_NEAR(m.weights.col(v).sum(), 1.0, 1e-12) << what;
+  Eigen::Index bad = -1;  // one check, not one assertion per vertex (property tests are long)
+  for (Eigen::Index v = 0; v < m.weights.cols() && bad < 0; ++v)
+    if (std::abs(m.weights.col(v).sum() - 1.0) > 1e-12) bad = v;
+  EXPECT_EQ(bad, -1) << what;
 }
 
 ScalpelSample vertical(double t, double x, double y) {
@@ -141,7 +143,7 @@ TEST(Tear, PropertyRandomScalpelPaths) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);
   int extended = 0, attempted = 0;
-  for (int trial = 0; trial < 60; ++trial) {
+  for (int trial = 0; trial < 300; ++trial) {
     const bool sheet = trial % 2 == 0;
     const SkinnedMesh in = sheet ? make_sheet(30, 30) : make_icosphere(3);
     SkinnedMesh m = in;
