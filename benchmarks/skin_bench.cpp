@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
     for (const char* k : {"BM_Cga", "BM_MatrixLbs", "BM_Versor", "BM_DualQuat"}) {
       const std::string base = std::string(k) + "/" + std::to_string(m);
       add_ratio(
-          base + "/1", base + "/2",
+          base + "/1/real_time", base + "/2/real_time",
           std::string(k) + " " + model_names[m] + ": 1-thread / 2-thread = speed-up (goal >= 1.8)");
     }
   add_ratio("BM_CgaBonesOnly/2", "BM_MatrixBonesOnly/2", "per-bone step only, FBX model");

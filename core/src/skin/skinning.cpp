@@ -199,12 +199,17 @@ void CgaSkinningJob<T>::run() const {
 #pragma omp parallel for schedule(static) num_threads(skin_threads(threads, input.x.size()))
   for (std::ptrdiff_t v = 0; v < n; ++v) {
     const T x = px[v], y = py[v], z = pz[v];
-    T ax = 0, ay = 0, az = 0;
-    for (int k = 0; k < K; ++k) {
-      const T w = weights[k * n + v];
-      if (w == T(0)) break;  // sorted: the rest are zero
-      // w_n down(V_n c V_n⁻¹) = w_n (A_n x + b_n)
-      const T* m = kern[bones[k * n + v]].m;
+    // w_n down(V_n c V_n⁻¹) = w_n (A_n x + b_n); the first term (always present) starts the
+    // sum, the others follow until the first zero weight (sorted: the rest are zero).
+    const T* m = kern[bones[v]].m;
+    T w = weights[v];
+    T ax = w * (m[0] * x + m[1] * y + m[2] * z + m[3]);
+    T ay = w * (m[4] * x + m[5] * y + m[6] * z + m[7]);
+    T az = w * (m[8] * x + m[9] * y + m[10] * z + m[11]);
+    for (int k = 1; k < K; ++k) {
+      w = weights[k * n + v];
+      if (w == T(0)) break;
+      m = kern[bones[k * n + v]].m;
       ax += w * (m[0] * x + m[1] * y + m[2] * z + m[3]);
       ay += w * (m[4] * x + m[5] * y + m[6] * z + m[7]);
       az += w * (m[8] * x + m[9] * y + m[10] * z + m[11]);
