@@ -1,6 +1,6 @@
 // The closed-form IK kernel shared by the scalar solver and the SIMD batch: branch-free
-// (every choice is a select), no library calls but sqrt, so that `#pragma omp simd` loops
-// vectorize it. Internal: use conform/ik/arm_ik.hpp.
+// (every choice is a select), no library calls, so that `#pragma omp simd` loops vectorize
+// it. Internal: use conform/ik/arm_ik.hpp.
 //
 // It is eqs 10–18 of the first paper re-derived from the geometry. With P̂ = Pw/L, L = |Pw|,
 // and the triangle factors f1 = d1+d2−L, f2 = L+d1−d2, f3 = L−d1+d2, f4 = L+d1+d2 (all ≥ 0
@@ -16,9 +16,12 @@
 //   eq 18  Qs = Q12 Q3
 // Half-angles use t = √((1+|c|)/2), u = s/(2t): accurate for every angle, unlike √((1−c)/2).
 //
-// No division and no std::sqrt: GCC keeps sqrt's errno path (a call per element) unless the
-// whole build uses -fno-math-errno, which blocks vectorization; every root and reciprocal
-// here is rsqrt() below (bit-trick seed + Newton, to the last ulp or two), which vectorizes.
+// Cost per solve: 6 square roots and 4 divisions (scalar path; the paper's Table 4, optimized:
+// 8 roots, 10 divisions), about 130 multiplications and additions, and a polynomial sincos of
+// φ (the paper's pipeline takes cos(φ/2), sin(φ/2) as inputs). In the vector path there is no
+// division and no std::sqrt: GCC keeps sqrt's errno path (a call per element) unless the whole
+// build uses -fno-math-errno, which would block vectorization; every root and reciprocal there
+// is rsqrt() below (bit-trick seed + Newton, to the last ulp or two), which vectorizes.
 #pragma once
 
 #include <bit>
