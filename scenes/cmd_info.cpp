@@ -54,8 +54,11 @@ void register_info(CLI::App& app, Context& context) {
   auto* cmd = app.add_subcommand(
       "info", "Print the version and features, or, given MODEL, its meshes, bones and animations");
   auto model = std::make_shared<std::string>();
+  auto options = std::make_shared<io::ImportOptions>();
   cmd->add_option("MODEL", *model, "model file (any format assimp reads) or arm[:N]");
-  cmd->callback([&context, model]() {
+  cmd->add_option("--weight-tolerance", options->weight_tolerance,
+                  "largest |sum of a vertex's weights - 1| accepted (renormalized; default 0.1)");
+  cmd->callback([&context, model, options]() {
     if (model->empty()) {
       std::cout << "conform " << conform::version() << "\n"
                 << "  Bullet precision: " << conform::bullet::bullet_precision() << "\n"
@@ -67,7 +70,7 @@ void register_info(CLI::App& app, Context& context) {
       return;
     }
     try {
-      print_model(io::load_model(*model));
+      print_model(io::load_model(*model, *options));
       context.exit_code = 0;
     } catch (const std::exception& e) {
       std::cerr << "conform info: " << e.what() << "\n";

@@ -21,6 +21,7 @@ struct SkinArgs {
   int frames = 0;
   int max_influences = 4;
   int threads = 0;
+  double weight_tolerance = 0.1;
 };
 
 using Clock = std::chrono::steady_clock;
@@ -62,7 +63,9 @@ int run_skin(const SkinArgs& a, bool has_time, bool has_frames) {
     throw std::invalid_argument("--out must end in .ply or .obj");
 
   auto t0 = Clock::now();
-  io::SkinnedModel model = io::load_model(a.model);
+  io::ImportOptions import_options;
+  import_options.weight_tolerance = a.weight_tolerance;
+  io::SkinnedModel model = io::load_model(a.model, import_options);
   const double load_ms = ms_since(t0);
   for (const auto& w : model.warnings)
     std::cerr << "warning: " << model.source << ": " << w << "\n";
@@ -139,6 +142,8 @@ void register_skin(CLI::App& app, Context& context) {
   cmd->add_option("--max-influences", args->max_influences,
                   "largest influences used per vertex (default 4)");
   cmd->add_option("--threads", args->threads, "OpenMP threads (default: all)");
+  cmd->add_option("--weight-tolerance", args->weight_tolerance,
+                  "largest |sum of a vertex's weights - 1| accepted (renormalized; default 0.1)");
   cmd->add_option("--out", args->out, "output .ply or .obj (with --frames: name_0000.ext, ...)")
       ->required();
   cmd->callback([&context, args, time, frames]() {
