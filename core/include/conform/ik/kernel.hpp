@@ -265,7 +265,9 @@ template <class T, bool kVector = true>
   const T h = c.two_d1d2 * ce * se * inv_l;
   const T pex = a * ux + h * wx, pey = a * uy + h * wy, pez = a * uz + h * wz;
 
-  // Q12 (eq 15): half-turn about the bisector of ê and σẑ.
+  // Q12 (eq 15): half-turn about the bisector of ê and σẑ. Eq 15 is (d1 − pez)(Pe + d1ẑ)
+  // normalized; its factor (d1 − pez) is dropped (0/0 with the elbow at +d1ẑ), and below the
+  // xy plane the −ẑ bisector avoids the 0/0 at −d1ẑ.
   const T ex = pex * c.inv_d1, ey = pey * c.inv_d1, ez = pez * c.inv_d1;
   const bool upper = ez >= T(0);
   const T mz = sel(upper, ez + T(1), ez - T(1));
@@ -286,6 +288,8 @@ template <class T, bool kVector = true>
   const T h3 = hh * inv_h3;
   const T v3 = s3 * T(0.5) * inv_h3;
   const T q3w = sel(c3 >= T(0), h3, std::fabs(v3));
+  // The sign of sin(θ3/2) is that of s3, not eq 17's sign(πyz2·Pw), which is 0/0 when the
+  // arm is straight.
   const T q3z = sel(c3 >= T(0), v3, sel(s3 >= T(0), h3, -h3));
 
   // Qs = Q12 Q3 (eq 18; q12w = 0 on the upper hemisphere, as in the paper).
@@ -294,6 +298,7 @@ template <class T, bool kVector = true>
   r.qs_x = sel(valid, q12x * q3w + q12y * q3z, T(0));
   r.qs_y = sel(valid, q12y * q3w - q12x * q3z, T(0));
   r.qs_z = sel(valid, q12z * q3w + q12w * q3z, T(0));
+  // Qe = cos(θ4/2) + sin(θ4/2) i: "+" where the extracted eq 14 prints "−" (readable note 3).
   r.qe_w = sel(valid, ce, T(1));
   r.qe_x = sel(valid, se, T(0));
   r.ex = sel(valid, pex, T(0));
