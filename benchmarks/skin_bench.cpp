@@ -3,7 +3,8 @@
 //   versor blend                           vs dual-quaternion skinning
 // on the procedural arm (default, 2,562 vertices; arm:20, 1,024,002 vertices) and on the
 // largest rigged model of Debian's assimp-testmodels (FBX/animation_with_skeleton.fbx, 2,464
-// vertices, 14 bones), with 4 influences, double precision, 1 and 2 OpenMP threads.
+// vertices, 14 bones), with 4 influences, double precision, 1 and 2 OpenMP threads; and CGA vs
+// matrix LBS in single precision on arm:20.
 // Arguments: /model/threads with model 0 = arm, 1 = arm:20, 2 = the FBX model.
 #include <benchmark/benchmark.h>
 
@@ -28,6 +29,7 @@ struct Setup {
   io::SkinnedModel model;
   skin::Pose pose;
   std::unique_ptr<skin::Skinner<double>> skinner;
+  std::unique_ptr<skin::Skinner<float>> skinner_f;  // single precision, same model and pose
 };
 
 // A pose that moves every bone: the arm bent at shoulder, elbow and wrist with a twist and a
@@ -54,6 +56,8 @@ Setup* setup(int which) {
   }
   s->skinner = std::make_unique<skin::Skinner<double>>(s->model.skeleton, s->model.mesh.rest,
                                                        s->model.influences, 4);
+  s->skinner_f = std::make_unique<skin::Skinner<float>>(s->model.skeleton, s->model.mesh.rest,
+                                                        s->model.influences, 4);
   return s.get();
 }
 
@@ -69,6 +73,24 @@ void run(benchmark::State& state, skin::SkinMode mode) {
                           static_cast<std::int64_t>(s->skinner->vertex_count()));
   state.counters["vertices"] = static_cast<double>(s->skinner->vertex_count());
   state.counters["bones"] = s->model.skeleton.bone_count();
+}
+
+void run_float(benchmark::State& state, skin::SkinMode mode) {
+  Setup* s = setup(static_cast<int>(state.range(0)));
+  s->skinner_f->set_threads(static_cast<int>(state.range(1)));
+  for (auto _ : state) {
+    s->skinner_f->skin(s->pose, mode);
+    benchmark::DoNotOptimize(s->skinner_f->output().x.data());
+    benchmark::ClobberMemory();
+  }
+  state.SetItemsProcessed(state.iterations() *
+                          static_cast<std::int64_t>(s->skinner_f->vertex_count()));
+}
+void BM_CgaFloat(benchmark::State& state) {
+  run_float(state, skin::SkinMode::cga);
+}
+void BM_MatrixLbsFloat(benchmark::State& state) {
+  run_float(state, skin::SkinMode::matrix_lbs);
 }
 
 void BM_Cga(benchmark::State& state) {
@@ -104,6 +126,12 @@ BENCHMARK(BM_Cga)->Apply(args);
 BENCHMARK(BM_MatrixLbs)->Apply(args);
 BENCHMARK(BM_Versor)->Apply(args);
 BENCHMARK(BM_DualQuat)->Apply(args);
+BENCHMARK(BM_CgaFloat)->Args({1, 1})->Args({1, 2})->UseRealTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_MatrixLbsFloat)
+    ->Args({1, 1})
+    ->Args({1, 2})
+    ->UseRealTime()
+    ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_CgaBonesOnly)->Arg(2)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_MatrixBonesOnly)->Arg(2)->Unit(benchmark::kMicrosecond);
 
@@ -163,6 +191,13 @@ int main(int argc, char** argv) {
       add_ratio(base + "/1/real_time", base + "/2/real_time",
                 std::string(k) + " " + model_names[m] + ": speed-up 1T/2T (goal >= 1.8; real)");
     }
+  for (int t : {1, 2}) {
+    const std::string a = "/1/" + std::to_string(t) + "/real_time";
+    add_ratio("BM_CgaFloat" + a, "BM_MatrixLbsFloat" + a,
+              "float: CGA / matrix LBS, arm:20, " + std::to_string(t) + "T");
+  }
+  add_ratio("BM_CgaFloat/1/1/real_time", "BM_CgaFloat/1/2/real_time",
+            "float: BM_CgaFloat arm:20: speed-up 1T/2T (real)");
   add_ratio("BM_CgaBonesOnly/2", "BM_MatrixBonesOnly/2", "per-bone step only, FBX model");
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
