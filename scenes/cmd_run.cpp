@@ -1,6 +1,8 @@
 // `conform run SCENE [--out DIR] [--steps N] [--set KEY=VALUE …]` and `conform scenes`.
 // SCENE is a built-in scene name or a JSON scene file. The scene is parsed completely before
 // anything is written, so a bad key or value leaves no folder behind.
+#include <omp.h>
+
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -55,6 +57,7 @@ int run_scene(const std::string& scene, const std::string& out_dir, int steps,
     std::cout << "conform run " << c.name << " (" << c.kind << "): " << c.steps << " steps of "
               << c.dt << " s, seed " << c.seed << "\n"
               << std::flush;
+    if (c.threads > 0) omp_set_num_threads(c.threads);
     scenes::RunOutput out(dir, c);
     const scenes::Json metrics = prepared->run(out);
     const scenes::Json summary =

@@ -22,6 +22,9 @@ CommonSettings read_common(Reader& root, const std::string& name, double default
   c.kind = root.text("scene", "");
   root.text("description", "");
   c.seed = static_cast<std::uint64_t>(root.integer("seed", 1, 0, 2147483647));
+  // One thread by default: the scenes' meshes are a few thousand vertices, where OpenMP's
+  // fork/join costs more than it saves (and ruins timings on a loaded machine).
+  c.threads = root.integer("threads", 1, 0, 1024);
   const double duration = root.number("duration", default_duration, 1e-6, 1e5);
   Reader physics = root.object("physics");
   c.dt = physics.number("dt", c.dt, 1e-5, 0.1);

@@ -46,6 +46,7 @@ struct CommonSettings {
   int metrics_every = 1;  // steps between metric rows
   int frames_every = 0;   // steps between PLY frames (0: first and last only)
   bool plots = true;
+  int threads = 1;  // OpenMP threads (0: OpenMP's default)
 };
 
 class RunOutput {
