@@ -493,8 +493,13 @@ TEST(IkEdges, InvalidInputs) {
       EXPECT_TRUE(s.qs.isApprox(Quatd::Identity()));
     }
   }
-  EXPECT_EQ(ik::solve(ik::Arm<double>{-1, 0.2, {}}, Vec3d(0.1, 0, 0), 0.0).status,
-            ik::Status::kInvalidInput);
+  for (const ik::Arm<double>& bad : {ik::Arm<double>{-1, 0.2, {}}, ik::Arm<double>{nan, 0.2, {}}}) {
+    for (const auto& s :
+         {ik::solve(bad, Vec3d(0.1, 0, 0), 0.0), ik::solve_readable(bad, Vec3d(0.1, 0, 0), 0.0)}) {
+      EXPECT_EQ(s.status, ik::Status::kInvalidInput);
+      EXPECT_TRUE(finite(s));
+    }
+  }
   // Full extension is not singular here (the paper's eq 17 is 0/0 there).
   const auto straight = ik::solve(arm, Vec3d(Vec3d(0.3, 0.4, 0.0).normalized() * 0.55), 0.7);
   EXPECT_EQ(straight.status, ik::Status::kOk);

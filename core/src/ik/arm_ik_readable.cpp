@@ -210,10 +210,11 @@ Solution<T> solve_prepared(const Arm<T>& arm, const Prepared<T>& p, T phi) {
 
 template <class T>
 Solution<T> solve_readable(const Arm<T>& arm, const Vec3<T>& target, T swivel) {
+  // As the closed form: identity pose, elbow at rest (at the origin for an invalid arm).
   Solution<T> invalid;
-  invalid.elbow = Vec3<T>(0, 0, arm.upper);
   invalid.status = Status::kInvalidInput;
   if (!arm.valid()) return invalid;
+  invalid.elbow = Vec3<T>(0, 0, arm.upper);
   const Prepared<T> p = prepare(arm, target, swivel);
   if (!p.valid) return invalid;
   Status extra = Status::kOk;
