@@ -55,6 +55,7 @@ void register_info(CLI::App& app, Context& context) {
       "info", "Print the version and features, or, given MODEL, its meshes, bones and animations");
   auto model = std::make_shared<std::string>();
   auto options = std::make_shared<io::ImportOptions>();
+  options->crash_guard = true;  // a corrupt file must not kill the command
   cmd->add_option("MODEL", *model, "model file (any format assimp reads) or arm[:N]");
   cmd->add_option("--weight-tolerance", options->weight_tolerance,
                   "largest |sum of a vertex's weights - 1| accepted (renormalized; default 0.1)");

@@ -54,6 +54,30 @@ INSTANTIATE_TEST_SUITE_P(
       return n;
     });
 
+// Files on which assimp 5.2 itself crashes (segfault in the Collada loader on a joint index
+// out of range, heap corruption in the X loader on a vertex index out of range): with the
+// crash guard the read happens in a child process first and the caller gets an ImportError.
+TEST(IoBroken, CrashGuardTurnsAssimpCrashesIntoErrors) {
+  conform::io::ImportOptions o;
+  o.crash_guard = true;
+  for (const char* f : {"box_joint_out_of_range.dae", "triangle_vertex_out_of_range.x"}) {
+    const std::string path = kBroken + f;
+    try {
+      conform::io::import_model(path, o);
+      ADD_FAILURE() << f;
+    } catch (const ImportError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(path, 0), 0u);
+      EXPECT_NE(std::string(e.what()).find("assimp crashed reading it"), std::string::npos)
+          << e.what();
+    }
+  }
+  // The guard lets good files through, with the same result.
+  const std::string good = std::string(CONFORM_ASSIMP_MODELS) + "/Collada/box_nested_animation.dae";
+  const auto a = conform::io::import_model(good, o), b = conform::io::import_model(good);
+  EXPECT_EQ(a.mesh.rest, b.mesh.rest);
+  EXPECT_EQ(a.skeleton.bone_count(), b.skeleton.bone_count());
+}
+
 TEST(IoBroken, MissingFileAndDirectory) {
   try {
     conform::io::import_model(kBroken + "does_not_exist.fbx");
@@ -83,7 +107,8 @@ TEST(IoBroken, InfoCommandExitsNonZero) {
   const std::string conform = std::string(CONFORM_BINARY_DIR) + "/scenes/conform";
   if (!std::filesystem::exists(conform)) GTEST_SKIP() << "conform not built";
   const std::string out = ::testing::TempDir() + "io_broken_info.txt";
-  for (const char* f : {"notes_renamed.fbx", "simple_skin_nan_key.gltf"}) {
+  for (const char* f :
+       {"notes_renamed.fbx", "simple_skin_nan_key.gltf", "box_joint_out_of_range.dae"}) {
     const std::string cmd = conform + " info " + kBroken + f + " > /dev/null 2> " + out;
     const int rc = std::system(cmd.c_str());
     EXPECT_NE(rc, 0) << f;

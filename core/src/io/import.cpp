@@ -12,6 +12,14 @@
 #include <map>
 #include <unordered_map>
 
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
 #include "conform/mesh/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 
@@ -333,6 +341,26 @@ void pose_current(SkinnedModel& m) {
   s.write(m.mesh.current);
 }
 
+// Reads the file in a forked child; empty when the child did not crash (it may still have
+// failed: the real read reports that), else why it crashed.
+std::string crashes_assimp(const std::string& file) {
+  std::fflush(nullptr);
+  const pid_t pid = fork();
+  if (pid < 0) return {};  // cannot fork: read in-process only
+  if (pid == 0) {
+    const int null = open("/dev/null", O_WRONLY);  // assimp's assert messages
+    if (null >= 0) dup2(null, 2);
+    Assimp::Importer importer;
+    _exit(importer.ReadFile(file, import_flags()) ? 0 : 1);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) return {};
+  if (!WIFSIGNALED(status)) return {};
+  return "assimp crashed reading it (" + std::string(strsignal(WTERMSIG(status))) +
+         "); the file is corrupt (e.g. bone or vertex indices out of range)";
+}
+
 }  // namespace
 
 int SkinnedModel::find_animation(const std::string& key) const {
@@ -361,6 +389,8 @@ SkinnedModel import_model(const std::filesystem::path& path, const ImportOptions
   const std::string ext = path.extension().string();
   if (ext.empty() || !importer.IsExtensionSupported(ext))
     throw ImportError(file, "unsupported format '" + ext + "' (assimp has no importer for it)");
+  if (options.crash_guard)
+    if (const auto why = crashes_assimp(file); !why.empty()) throw ImportError(file, why);
   const aiScene* scene = importer.ReadFile(file, import_flags());
   if (!scene) {
     std::string why = importer.GetErrorString();

@@ -44,6 +44,12 @@ struct ImportOptions {
   /// Largest |Σ w − 1| of a skinned vertex before import fails; sums off by more than 1e-4
   /// but within this are renormalized with a warning.
   double weight_tolerance = 0.1;
+  /// Read the file once in a forked child process first (POSIX), so that a file on which
+  /// assimp itself crashes (assimp 5.2 segfaults or aborts on out-of-range bone or vertex
+  /// indices in .x and .dae files) gives an ImportError instead of killing the caller. Costs
+  /// a second read. Off by default: forking a multithreaded host is only safe when no other
+  /// thread holds a lock the child needs; the `conform` command turns it on.
+  bool crash_guard = false;
 };
 
 /// The assimp post-processing flags used by import_model (aiPostProcessSteps bits).
