@@ -243,8 +243,8 @@ TEST(Cut, WeightsKeepFourLargestAndRenormalize) {
   m.weights.conservativeResize(4, 5);
   m.rest.conservativeResize(3, 5);
   m.current.conservativeResize(3, 5);
-  m.uvs.resize(0, 0);
-  m.normals.resize(0, 0);
+  m.uvs.resize(2, 0);
+  m.normals.resize(3, 0);
   blend_influences(m, {0, 2, -1}, {0.5, 0.5, 0}, 4);
   // Blend: 0:.2 1:.15 2:.1 3:.05 4:.35 5:.05 6:.05 7:.05 → keep 4, 0, 1, 2 → renormalize by .8.
   EXPECT_EQ(m.bones(0, 4), 4);
