@@ -780,8 +780,8 @@ void SkinnedSoftBody::update(double dt, double time) {
 // --- Queries ---
 
 std::int32_t SkinnedSoftBody::piece_count() const {
-  return std::int32_t(
-      std::count_if(pieces_.begin(), pieces_.end(), [](auto& p) { return bool(p); }));
+  return std::int32_t(std::count_if(pieces_.begin(), pieces_.end(),
+                                    [](auto& p) { return p && p->body->m_faces.size() > 0; }));
 }
 
 std::vector<btSoftBody*> SkinnedSoftBody::pieces() const {

@@ -120,8 +120,10 @@ class SkinnedSoftBody {
   const Material& material() const { return material_; }
   void sync_mesh();
   std::int32_t vertex_count() const { return mesh_.vertex_count(); }
+  /// Connected pieces of the mesh (bodies holding faces).
   std::int32_t piece_count() const;
-  /// The live pieces' soft bodies.
+  /// Every soft body in the world, including one whose faces were all removed and that only
+  /// keeps its loose nodes (and their mass).
   std::vector<btSoftBody*> pieces() const;
   Eigen::Vector3d position(std::int32_t vertex) const;
   Eigen::Vector3d velocity(std::int32_t vertex) const;
