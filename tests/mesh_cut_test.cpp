@@ -410,6 +410,8 @@ TEST(Cut, ReDeformation) {
     }
     EXPECT_LT(worst_same, 1e-9) << "z " << z;
     EXPECT_LT(worst_blend, 2e-3) << "z " << z;  // well under the arm's 6 mm ring spacing
+    RecordProperty("worst_blended_z" + std::to_string(int(z * 100)), std::to_string(worst_blend));
+    RecordProperty("worst_exact_z" + std::to_string(int(z * 100)), std::to_string(worst_same));
   }
 }
 
