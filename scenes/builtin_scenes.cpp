@@ -11,6 +11,9 @@ const std::vector<SceneKind>& scene_kinds() {
   static const std::vector<SceneKind> kinds = {
       {"tear-opening", &make_tear_opening},
       {"arm-track", &make_arm_track},
+      {"cut", &make_cut},
+      {"drill", &make_drill},
+      {"character", &make_character},
   };
   return kinds;
 }
@@ -65,6 +68,56 @@ const std::vector<BuiltinScene>& builtin_scenes() {
   "physics": { "dt": 0.016666666666666666, "substeps": 4, "solver_iterations": 10,
                "gravity": [0, -9.81, 0] },
   "outputs": { "metrics_every": 1, "frames_every": 60, "plots": true }
+})json"},
+      {"cut",
+       "a planar cut through the forearm of the moving soft arm; the pieces keep simulating under "
+       "gravity, the hand piece stays skinned to its bones",
+       R"json({
+  "scene": "cut",
+  "description": "The moving procedural arm as a CGA-skinned Bullet soft body (every node pulled toward its skinned target) is cut through the forearm by a plane; both pieces keep simulating under gravity and the hand piece keeps following the wrist and hand bones.",
+  "seed": 1,
+  "duration": 3.0,
+  "model": { "resolution": 1 },
+  "pose": { "shoulder_swing_deg": 20, "elbow_deg": 10, "elbow_swing_deg": 40, "period": 2 },
+  "material": { "target_stiffness": 4000, "target_damping": 40, "kinematic_weight": 2,
+                "damping": 0.02 },
+  "cut": { "at": 0.5, "point": [0, 0, 0.4234], "normal": [0, 0.05, 1], "cap": false },
+  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json"},
+      {"drill",
+       "a hole drilled through the upper arm, then the arm moves; the hole's rim stays on the skin",
+       R"json({
+  "scene": "drill",
+  "description": "A cylindrical drill (radius 12 mm) goes through both walls of the upper arm of the CGA-skinned soft arm; the arm then swings and flexes, and the rim nodes are measured against their skinned targets.",
+  "seed": 1,
+  "duration": 3.0,
+  "model": { "resolution": 1 },
+  "pose": { "shoulder_swing_deg": 20, "elbow_deg": 10, "elbow_swing_deg": 40, "period": 2 },
+  "material": { "target_stiffness": 4000, "target_damping": 40, "kinematic_weight": 2,
+                "damping": 0.02 },
+  "drill": { "at": 0.5, "tip": [0.1, 0.0031, 0.1512], "base": [-0.1, 0.0031, 0.1512],
+             "radius": 0.012 },
+  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json"},
+      {"character",
+       "a real rigged model (assimp) plays its animation through CGA skinning with soft-body "
+       "secondary motion",
+       R"json({
+  "scene": "character",
+  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body: nodes close to one bone ride it, blended regions follow their skinned targets softly.",
+  "seed": 1,
+  "duration": 1.56,
+  "model": { "file": "/usr/share/assimp/models/FBX/huesitos.fbx", "animation": "0",
+             "units_per_metre": 100 },
+  "material": { "link_stiffness": 0.02, "target_stiffness": 2000, "target_damping": 20,
+                "kinematic_weight": 0.95, "damping": 0.01 },
+  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
 })json"},
   };
   return scenes;
