@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libbullet-dev libassimp-dev assimp-testmodels
   libgtest-dev libgmock-dev libbenchmark-dev libomp-dev
   libcli11-dev nlohmann-json3-dev
+  gnuplot-nox  # conform run draws its PNG plots with it
 )
 
 missing=()

@@ -3,8 +3,8 @@
 # with nothing written, the files a run writes, and identical numbers for the same seed.
 # Usage: bash run_scenes_test.sh <conform> <source dir> <build dir>
 set -euo pipefail
-conform="$1"
-tmp="$(mktemp -d)"
+conform="$(realpath "$1")"
+tmp="$(realpath "$(mktemp -d)")"
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "run_scenes_test: $*" >&2; exit 1; }
 
@@ -69,4 +69,20 @@ fi
 "$conform" run arm-track --steps 700 --set outputs.plots=false --out "$tmp/d" > /dev/null 2>&1 ||
   fail "run with seed 7 failed"
 cmp -s "$tmp/c/metrics.csv" "$tmp/d/metrics.csv" && fail "seeds 7 and 8 gave the same run"
+# The main job: `conform` alone runs the default scene and says where the results went.
+mkdir -p "$tmp/default"
+(cd "$tmp/default" && "$conform" > out.log 2>&1) || { cat "$tmp/default/out.log" >&2; fail "conform alone failed"; }
+grep -q "running the default scene 'tear-opening'" "$tmp/default/out.log" || fail "no default-scene notice"
+grep -q "results in $tmp/default/results/tear-opening/" "$tmp/default/out.log" ||
+  fail "conform alone does not say where the results went"
+for f in summary.json metrics.csv profiles.csv profile_history.csv; do
+  [[ -s "$tmp/default/results/tear-opening/$f" ]] || fail "default run: missing $f"
+done
+for key in '"max_opening"' '"profile_r2"' '"opened_area"'; do
+  grep -q "$key" "$tmp/default/results/tear-opening/summary.json" || fail "default run: no $key"
+done
+# Every built-in scene is listed.
+for s in tear-opening arm-track cut drill character; do
+  grep -q "^$s " "$tmp/list" || fail "scenes does not list $s"
+done
 echo "run_scenes_test: ok"

@@ -1,0 +1,131 @@
+// The built-in scenes, run through the `conform` command, against physical expectations:
+// tracking-error bounds of arm-track, gravity compensation holding an unpowered arm, a tear
+// that opens by physics only under pretension, and the cut/drill/character scenes following
+// their skins. Each run is a few seconds of simulated time (well under a second of wall time
+// in Release).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+// Runs `conform run SCENE ARGS` into a fresh folder; returns summary.json (null on failure).
+Json run(const std::string& scene, const std::string& args, const std::string& tag) {
+  const fs::path conform = fs::path(CONFORM_BINARY_DIR) / "scenes" / "conform";
+  if (!fs::exists(conform)) {
+    ADD_FAILURE() << "build the conform command first: " << conform;
+    return {};
+  }
+  const fs::path dir = fs::path(testing::TempDir()) / ("conform_scene_" + tag);
+  fs::remove_all(dir);
+  const std::string cmd = conform.string() + " run " + scene + " --out " + dir.string() +
+                          " --set outputs.plots=false " + args + " > " + dir.string() + ".log 2>&1";
+  const int rc = std::system(cmd.c_str());
+  std::ifstream log(dir.string() + ".log");
+  const std::string text((std::istreambuf_iterator<char>(log)), {});
+  if (rc != 0) {
+    ADD_FAILURE() << cmd << " failed:\n" << text;
+    return {};
+  }
+  std::ifstream in(dir / "summary.json");
+  Json summary = Json::parse(in, nullptr, false);
+  EXPECT_TRUE(summary.is_object()) << "no summary.json in " << dir;
+  return summary;
+}
+
+TEST(SceneArmTrack, FollowsTheIkTargetWithinBounds) {
+  const Json s = run("arm-track", "", "arm_track");
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  const Json& with = m["with_gravity_compensation"];
+  const Json& without = m["without_gravity_compensation"];
+  // Moving target (figure-eight 0.24 m/s, waypoints): a few millimetres of lag at most.
+  EXPECT_LT(with["rms_error"].get<double>(), 0.004);
+  EXPECT_LT(with["max_error"].get<double>(), 0.008);
+  // Held waypoints: the servo settles onto the target.
+  EXPECT_LT(with["steady_state_error"].get<double>(), 1e-4);
+  EXPECT_LT(without["steady_state_error"].get<double>(), 1e-3);
+  // The torque-limited servo saturates against gravity somewhere without compensation.
+  EXPECT_GE(without["max_error"].get<double>(), with["max_error"].get<double>());
+  EXPECT_EQ(m["rms_error"], with["rms_error"]);
+  EXPECT_GT(m["ik_ns_per_solve"].get<double>(), 0);
+  EXPECT_LT(m["ik_ns_per_solve"].get<double>(), 1e5);
+  EXPECT_EQ(m["ik_targets_moved"].get<int>(), 0);
+  // The CGA-skinned skin sits on Bullet's links (float Bullet: ~1e-7 m).
+  EXPECT_LT(m["skin_max_offset_from_bones"].get<double>(), 1e-5);
+  EXPECT_GT(s["timings"]["wall_per_simulated_second_s"].get<double>(), 0);
+  EXPECT_GT(s["timings"]["wall_per_step_ms"].get<double>(), 0);
+}
+
+TEST(SceneArmTrack, GravityCompensationAloneHoldsAnUnpoweredArm) {
+  // Motors without torque, a still target: only the feed-forward torques hold the arm up.
+  const Json s = run("arm-track",
+                     "--set arm.shoulder_max_torque=0 --set arm.elbow_max_torque=0 "
+                     "--set targets.figure_eight.width=0 --set targets.figure_eight.height=0 "
+                     "--set targets.figure_eight.duration=1 --set targets.waypoints.count=0",
+                     "arm_hold");
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  EXPECT_LT(m["with_gravity_compensation"]["max_error"].get<double>(), 2e-3);
+  EXPECT_GT(m["without_gravity_compensation"]["max_error"].get<double>(), 0.05);  // it falls
+}
+
+TEST(SceneTearOpening, OpensByPhysicsUnderPretensionOnly) {
+  const Json s = run("tear-opening", "--set duration=2", "tear");
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  EXPECT_GT(m["physics"]["tear_points"].get<int>(), 20);
+  EXPECT_GT(m["physics"]["max_opening"].get<double>(), 0.003);
+  EXPECT_GT(m["physics"]["profile_r2"].get<double>(), 0.5);
+  EXPECT_GT(m["physics"]["opened_area"].get<double>(), 1e-4);
+  // Step 6 moves the borders apart by the prescribed amount at the middle.
+  EXPECT_NEAR(m["geometric"]["max_opening"].get<double>(), 0.01, 0.001);
+  EXPECT_GT(m["geometric"]["tear_points"].get<int>(), 20);
+
+  const Json slack = run("tear-opening", "--set duration=2 --set material.pretension=0", "slack");
+  ASSERT_TRUE(slack.is_object());
+  EXPECT_GT(slack["metrics"]["physics"]["tear_points"].get<int>(), 20);
+  EXPECT_LT(slack["metrics"]["physics"]["max_opening"].get<double>(),
+            0.2 * m["physics"]["max_opening"].get<double>());
+}
+
+TEST(SceneCut, PiecesKeepSimulatingAndTheHandFollowsItsBones) {
+  const Json s = run("cut", "--set duration=1.5", "cut");
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  EXPECT_EQ(m["pieces"].get<int>(), 2);
+  EXPECT_EQ(m["event"]["status"], "cut");
+  EXPECT_GT(m["event"]["hand_piece_vertices"].get<int>(), 100);
+  EXPECT_LT(m["hand_offset_max_over_time"].get<double>(), 0.01);
+}
+
+TEST(SceneDrill, TheRimStaysOnTheSkin) {
+  const Json s = run("drill", "--set duration=1.5", "drill");
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  EXPECT_EQ(m["event"]["holes"].get<int>(), 2);  // through both walls
+  EXPECT_GT(m["event"]["rim_nodes"].get<int>(), 24);
+  EXPECT_LT(m["rim_offset_max_over_time"].get<double>(), 0.01);
+}
+
+TEST(SceneCharacter, RealModelPlaysItsAnimationAsASoftBody) {
+  if (!fs::exists("/usr/share/assimp/models/FBX/huesitos.fbx"))
+    GTEST_SKIP() << "assimp-testmodels is not installed";
+  const Json s = run("character", "", "character");
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  EXPECT_EQ(m["vertices"].get<int>(), 128);
+  EXPECT_EQ(m["bones"].get<int>(), 9);
+  EXPECT_GT(m["kinematic_nodes"].get<int>(), 0);
+  EXPECT_GT(m["secondary_motion_mean_m"].get<double>(), 0);   // the soft nodes do lag
+  EXPECT_LT(m["secondary_motion_max_m"].get<double>(), 1.0);  // the model spans ~5 m
+}
+
+}  // namespace
