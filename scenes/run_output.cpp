@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <iostream>
 
 #include "conform/bullet/convert.hpp"
@@ -64,7 +65,7 @@ void RunOutput::Csv::row(std::span<const double> values) {
 }
 
 RunOutput::RunOutput(fs::path dir, const CommonSettings& common)
-    : dir_(std::move(dir)), common_(common), start_(Clock::now()) {
+    : dir_(std::move(dir)), common_(common), start_(Clock::now()), cpu_start_(std::clock()) {
   std::error_code ec;
   fs::create_directories(dir_ / "frames", ec);
   if (ec)
@@ -191,6 +192,11 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
       simulated_seconds > 0 ? loop_seconds / simulated_seconds : 0.0;
   timings["wall_per_step_ms"] = steps > 0 ? 1e3 * loop_seconds / steps : 0.0;
   timings["real_time_factor"] = loop_seconds > 0 ? simulated_seconds / loop_seconds : 0.0;
+  // Process CPU time (all of the run, setup included): steadier than wall time on a busy
+  // machine, where the wall figures above include time spent waiting for a core.
+  const double cpu = double(std::clock() - cpu_start_) / CLOCKS_PER_SEC;
+  timings["cpu_s"] = cpu;
+  timings["cpu_per_simulated_second_s"] = simulated_seconds > 0 ? cpu / simulated_seconds : 0.0;
   summary["timings"] = timings;
   summary["metrics"] = metrics;
   summary["frames"] = frames_;

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -95,6 +96,7 @@ class RunOutput {
   std::filesystem::path dir_;
   CommonSettings common_;
   Clock::time_point start_;
+  std::clock_t cpu_start_;
   std::unique_ptr<Csv> metrics_;
   std::vector<Plot> plots_;
   int frames_ = 0;
