@@ -2,12 +2,6 @@
 // The arithmetic is detail::solve_kernel (kernel.hpp, formulas beside it); this file only
 // feeds it, vectorizes the batch loop and splits it across OpenMP threads.
 
-// sqrt must not set errno here: the errno path is a library call per element, which stops
-// the loop from vectorizing. Every sqrt argument in the kernel is ≥ 0 by construction.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC optimize("no-math-errno")
-#endif
-
 #include <omp.h>
 
 #include <algorithm>
