@@ -5,6 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include <memory>
+#include <string>
 
 #include "../tests/plugin_world.hpp"
 #include "conform/bullet/plugin.hpp"
@@ -39,9 +40,9 @@ struct LiveArm {
   SoftWorld w;
   bullet::Plugin plugin{w.world};
   bullet::SkinnedSoftBody* body;
-  explicit LiveArm(int warmup = 10) {
+  explicit LiveArm(int warmup = 10, double pretension = 0.05) {
     const auto& arm = the_arm();
-    body = &plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = 0.05});
+    body = &plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = pretension});
     skin::PoseTrack track;
     track.set_key(0, skin::Pose::rest(arm.skeleton));
     track.set_key(1, bent(arm.skeleton, 0.7, 1.2));
@@ -52,26 +53,46 @@ struct LiveArm {
 };
 
 void BM_StepSkinned(benchmark::State& state) {
-  LiveArm a;
+  LiveArm a(10, double(state.range(0)) / 100);
   for (auto _ : state) a.w.step();
   state.counters["nodes"] = a.body->vertex_count();
 }
-BENCHMARK(BM_StepSkinned)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_StepSkinned)->Arg(5)->Arg(0)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 // The same pieces (nodes, links, faces, masses, kinematic nodes with inverse mass 0) built by
 // SkinnedSoftBody but never driven: no action, no skinning, no rest-length re-application.
 void BM_StepUnskinned(benchmark::State& state) {
+  const double pretension = double(state.range(0)) / 100;
   SoftWorld w;
   const auto& arm = the_arm();
   bullet::SkinnedSoftBody body(
       w.world.getWorldInfo(), [&](btSoftBody* b) { w.world.addSoftBody(b); },
       [&](btSoftBody* b) { w.world.removeSoftBody(b); }, arm.mesh, arm.skeleton,
-      {.pretension = 0.05});
+      {.pretension = pretension});
   w.step(10);
   for (auto _ : state) w.step();
   state.counters["nodes"] = body.vertex_count();
 }
-BENCHMARK(BM_StepUnskinned)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK(BM_StepUnskinned)->Arg(5)->Arg(0)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+// The skinned arm held in its rest pose: the same action (skinning, driving, rest lengths)
+// but nodes that do not move, so Bullet's own work is that of the unskinned baseline.
+void BM_StepSkinnedStill(benchmark::State& state) {
+  LiveArm a(10, double(state.range(0)) / 100);
+  a.body->set_pose(skin::Pose::rest(the_arm().skeleton));
+  a.w.step(10);
+  for (auto _ : state) a.w.step();
+}
+BENCHMARK(BM_StepSkinnedStill)->Arg(5)->Arg(0)->Unit(benchmark::kMillisecond)->MinTime(1.0);
+
+// The plugin's whole per-substep action (pose, skinning, driving the nodes, rest lengths),
+// without Bullet's step.
+void BM_ActionOnly(benchmark::State& state) {
+  LiveArm a;
+  double t = a.plugin.time();
+  for (auto _ : state) a.body->update(1.0 / 60, t += 1.0 / 60);
+}
+BENCHMARK(BM_ActionOnly)->Unit(benchmark::kMicrosecond);
 
 // Skinning alone (pose, per-bone kernels, eq 17 vertex loop) for one substep.
 void BM_SkinTargets(benchmark::State& state) {
@@ -185,6 +206,12 @@ BENCHMARK(BM_OpeningTearStep)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 }  // namespace
 
 int main(int argc, char** argv) {
-  conform::bench::add_ratio("BM_StepSkinned", "BM_StepUnskinned", "skinned / unskinned step");
+  for (const char* s : {"5", "0"}) {
+    const std::string base = std::string("BM_StepUnskinned/") + s + "/min_time:1.000";
+    conform::bench::add_ratio(std::string("BM_StepSkinned/") + s + "/min_time:1.000", base,
+                              std::string("animated skinned / unskinned, s = 0.0") + s);
+    conform::bench::add_ratio(std::string("BM_StepSkinnedStill/") + s + "/min_time:1.000", base,
+                              std::string("still skinned / unskinned, s = 0.0") + s);
+  }
   return conform::bench::run_with_ratios(argc, argv);
 }

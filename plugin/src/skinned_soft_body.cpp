@@ -42,6 +42,7 @@ struct SkinnedSoftBody::Piece {
   std::vector<std::int32_t> node_vertex;  // node index → mesh vertex
   std::vector<double> rest;               // link index → our rest length (Bullet resets its own)
   std::vector<std::int32_t> face_id;      // Bullet face slot → mesh face
+  bool reapply = true;                    // we edited the body: Bullet resets rest lengths
 };
 
 SkinnedSoftBody::SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
@@ -179,6 +180,10 @@ void SkinnedSoftBody::set_node_mass(std::int32_t v) {
   const auto i = static_cast<std::size_t>(v);
   btSoftBody::Node& node = body_of(v)->m_nodes[node_of_[i]];
   node.m_im = kinematic_[i] ? btScalar(0) : btScalar(1 / mass_[i]);
+  // Link constants (c0) depend on inverse masses: Bullet recomputes them, and resets rest
+  // lengths, at the next step.
+  body_of(v)->m_bUpdateRtCst = true;
+  pieces_[static_cast<std::size_t>(piece_of_[i])]->reapply = true;
 }
 
 void SkinnedSoftBody::add_node(std::int32_t p, std::int32_t v, const Eigen::Vector3d& x,
@@ -193,6 +198,7 @@ void SkinnedSoftBody::add_node(std::int32_t p, std::int32_t v, const Eigen::Vect
   piece.node_vertex.push_back(v);
   set_node_mass(v);
   body.m_bUpdateRtCst = true;
+  piece.reapply = true;
 }
 
 void SkinnedSoftBody::add_face(std::int32_t p, std::int32_t f) {
@@ -204,6 +210,7 @@ void SkinnedSoftBody::add_face(std::int32_t p, std::int32_t f) {
   face_piece_[static_cast<std::size_t>(f)] = p;
   face_slot_[static_cast<std::size_t>(f)] = piece.body->m_faces.size() - 1;
   piece.face_id.push_back(f);
+  piece.reapply = true;
 }
 
 void SkinnedSoftBody::remove_face_from_bullet(std::int32_t f) {
@@ -224,6 +231,7 @@ void SkinnedSoftBody::remove_face_from_bullet(std::int32_t f) {
   face_piece_[static_cast<std::size_t>(f)] = -1;
   face_slot_[static_cast<std::size_t>(f)] = -1;
   body.m_bUpdateRtCst = true;
+  piece.reapply = true;
   ++stats_.removed_faces;
 }
 
@@ -236,6 +244,7 @@ void SkinnedSoftBody::add_link(std::int32_t p, std::int32_t u, std::int32_t v, d
   link.m_rl = btScalar(rest);
   link.m_c1 = btScalar(rest * rest);
   piece.rest.push_back(rest);
+  piece.reapply = true;
   const auto [a, b] = edge_key(u, v);
   edge_link_.insert(a, b, body.m_links.size() - 1, true);
   ++stats_.added_links;
@@ -264,6 +273,7 @@ void SkinnedSoftBody::remove_link(std::int32_t p, std::int32_t li) {
   body.m_links.pop_back();
   piece.rest.pop_back();
   body.m_bUpdateRtCst = true;
+  piece.reapply = true;
   ++stats_.removed_links;
 }
 
@@ -302,6 +312,7 @@ void SkinnedSoftBody::remove_nodes(std::int32_t p, const std::vector<std::int32_
   while (body.m_nodes.size() > j) body.m_nodes.pop_back();  // resize() would build a Node
   piece.node_vertex.resize(static_cast<std::size_t>(j));
   body.m_bUpdateRtCst = true;
+  piece.reapply = true;
 }
 
 void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
@@ -695,6 +706,7 @@ void SkinnedSoftBody::set_pinned(std::span<const std::int32_t> vertices) {
     kinematic_[i] = k;
     set_node_mass(v);
     body_of(v)->m_bUpdateRtCst = true;  // link constants depend on inverse masses
+    pieces_[static_cast<std::size_t>(piece_of_[i])]->reapply = true;
   }
 }
 
@@ -731,6 +743,7 @@ void SkinnedSoftBody::skin_targets(double time) {
   job.input = {rest_soa_.x,          rest_soa_.y, rest_soa_.z,
                mesh::kMaxInfluences, soa_bones_,  soa_weights_};
   job.output = {target_.x, target_.y, target_.z};
+  job.threads = skin_threads_;
   job.run();
 }
 
@@ -768,7 +781,12 @@ void SkinnedSoftBody::update(double dt, double time) {
         node.m_x += (error * btScalar(k) - relative * btScalar(c)) * btScalar(dt2 / denom);
       }
     }
-    // Bullet resets every rest length after an edit; ours (with pretension) win.
+    // Bullet resets every rest length at once (updateConstants, after any edit); one link
+    // tells whether it happened since we last wrote them, and then ours (with pretension) win.
+    if (!piece->reapply &&
+        (body.m_links.size() == 0 || body.m_links[0].m_rl == btScalar(piece->rest[0])))
+      continue;
+    piece->reapply = false;
     for (int i = 0; i < body.m_links.size(); ++i) {
       const double r = piece->rest[static_cast<std::size_t>(i)];
       body.m_links[i].m_rl = btScalar(r);
