@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "conform/bullet/convert.hpp"
 #include "conform/bullet/plugin.hpp"
 #include "conform/mesh/procedural_arm.hpp"
 
