@@ -16,9 +16,9 @@ using conform::test::SoftWorld;
 
 namespace {
 
-constexpr double kHalf = 0.5;        // the patch spans [−0.5, 0.5]²
-constexpr double kTearHalf = 0.25;   // the tear runs from x = −0.25 to 0.25
-constexpr double kTearY = 0.0123;    // off the grid lines
+constexpr double kHalf = 0.5;       // the patch spans [−0.5, 0.5]²
+constexpr double kTearHalf = 0.25;  // the tear runs from x = −0.25 to 0.25
+constexpr double kTearY = 0.0123;   // off the grid lines
 
 struct Profile {
   std::vector<double> x, w;  // position along the tear (rest space), gap width
@@ -96,8 +96,7 @@ Profile tear_and_settle(double pretension, SoftWorld& w, bullet::Plugin& plugin)
     p.x.push_back(body.mesh().rest(0, right[i]));
     p.w.push_back((body.position(left[i]) - body.position(right[i])).norm());
   }
-  for (std::int32_t v = 0; v < body.vertex_count(); ++v)
-    EXPECT_TRUE(body.position(v).allFinite());
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v) EXPECT_TRUE(body.position(v).allFinite());
   return p;
 }
 

@@ -21,12 +21,14 @@ namespace {
 
 skin::Pose swing(const skin::Skeleton& skeleton, double shoulder, double elbow) {
   skin::Pose pose = skin::Pose::rest(skeleton);
-  pose.apply_local(0, skin::Versor::from_trs(cga::Vec3<double>(0, 0, 0),
-                                              cga::Quat<double>(Eigen::AngleAxisd(shoulder, Eigen::Vector3d::UnitY())),
-                                              1.0));
-  pose.apply_local(1, skin::Versor::from_trs(cga::Vec3<double>(0, 0, 0),
-                                              cga::Quat<double>(Eigen::AngleAxisd(elbow, Eigen::Vector3d::UnitX())),
-                                              1.0));
+  pose.apply_local(
+      0, skin::Versor::from_trs(
+             cga::Vec3<double>(0, 0, 0),
+             cga::Quat<double>(Eigen::AngleAxisd(shoulder, Eigen::Vector3d::UnitY())), 1.0));
+  pose.apply_local(1,
+                   skin::Versor::from_trs(
+                       cga::Vec3<double>(0, 0, 0),
+                       cga::Quat<double>(Eigen::AngleAxisd(elbow, Eigen::Vector3d::UnitX())), 1.0));
   return pose;
 }
 
@@ -95,13 +97,16 @@ void expect_mirrors_mesh(const bullet::SkinnedSoftBody& body, const char* what) 
   std::vector<int> seen(std::size_t(m.vertex_count()), 0);
   std::size_t links = 0;
   for (btSoftBody* sb : body.pieces()) {
-    auto vertex = [&](const btSoftBody::Node* n) { return body.vertex_of(sb, int(n - &sb->m_nodes[0])); };
+    auto vertex = [&](const btSoftBody::Node* n) {
+      return body.vertex_of(sb, int(n - &sb->m_nodes[0]));
+    };
     for (int i = 0; i < sb->m_nodes.size(); ++i) ++seen[std::size_t(body.vertex_of(sb, i))];
     // Faces connected through shared nodes (a union-find over this body's nodes).
     std::vector<int> parent(std::size_t(sb->m_nodes.size()));
     for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = int(i);
     auto find = [&](int a) {
-      while (parent[std::size_t(a)] != a) a = parent[std::size_t(a)] = parent[std::size_t(parent[std::size_t(a)])];
+      while (parent[std::size_t(a)] != a)
+        a = parent[std::size_t(a)] = parent[std::size_t(parent[std::size_t(a)])];
       return a;
     };
     std::set<int> with_faces;
@@ -109,7 +114,8 @@ void expect_mirrors_mesh(const bullet::SkinnedSoftBody& body, const char* what) 
       const auto& f = sb->m_faces[i];
       bullet_faces.insert(canonical({vertex(f.m_n[0]), vertex(f.m_n[1]), vertex(f.m_n[2])}));
       for (int k = 0; k < 3; ++k) {
-        const int a = int(f.m_n[k] - &sb->m_nodes[0]), b = int(f.m_n[(k + 1) % 3] - &sb->m_nodes[0]);
+        const int a = int(f.m_n[k] - &sb->m_nodes[0]),
+                  b = int(f.m_n[(k + 1) % 3] - &sb->m_nodes[0]);
         parent[std::size_t(find(a))] = find(b);
         with_faces.insert(a);
       }
@@ -122,16 +128,17 @@ void expect_mirrors_mesh(const bullet::SkinnedSoftBody& body, const char* what) 
       const std::int32_t a = vertex(l.m_n[0]), b = vertex(l.m_n[1]);
       const std::pair<std::int32_t, std::int32_t> e = std::minmax(a, b);
       ASSERT_TRUE(mesh_edges.count(e)) << what << ": link without a face";
-      ASSERT_NEAR(double(l.m_rl), body.rest_length(e.first, e.second), 1e-6 * double(l.m_rl) + 1e-12);
+      ASSERT_NEAR(double(l.m_rl), body.rest_length(e.first, e.second),
+                  1e-6 * double(l.m_rl) + 1e-12);
       ++links;
     }
   }
   EXPECT_EQ(mesh_faces.size(), bullet_faces.size()) << what;
   std::vector<std::array<std::int32_t, 3>> only_mesh, only_bullet;
-  std::set_difference(mesh_faces.begin(), mesh_faces.end(), bullet_faces.begin(), bullet_faces.end(),
-                      std::back_inserter(only_mesh));
-  std::set_difference(bullet_faces.begin(), bullet_faces.end(), mesh_faces.begin(), mesh_faces.end(),
-                      std::back_inserter(only_bullet));
+  std::set_difference(mesh_faces.begin(), mesh_faces.end(), bullet_faces.begin(),
+                      bullet_faces.end(), std::back_inserter(only_mesh));
+  std::set_difference(bullet_faces.begin(), bullet_faces.end(), mesh_faces.begin(),
+                      mesh_faces.end(), std::back_inserter(only_bullet));
   EXPECT_TRUE(only_mesh.empty() && only_bullet.empty())
       << what << ": " << only_mesh.size() << " faces only in the mesh, " << only_bullet.size()
       << " only in Bullet";
@@ -222,7 +229,8 @@ TEST(PluginTopology, DrillKeepsTheHolesNodesAndMass) {
       if (std::abs(a.arm.mesh.rest(2, v) - 0.15) < 0.01) mean += body.position(v), ++n;
     return Eigen::Vector3d(mean / n);
   }();
-  const auto result = body.drill({c + Eigen::Vector3d(0, 0.2, 0), c - Eigen::Vector3d(0, 0.2, 0), 0.012});
+  const auto result =
+      body.drill({c + Eigen::Vector3d(0, 0.2, 0), c - Eigen::Vector3d(0, 0.2, 0), 0.012});
   ASSERT_EQ(result.holes, 2) << result.message;
   expect_conserved(body, before, result.changes, "drill");
   expect_mirrors_mesh(body, "drill");
