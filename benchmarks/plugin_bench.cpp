@@ -23,19 +23,6 @@ const mesh::Arm& the_arm() {
   return arm;
 }
 
-skin::Pose bent(const skin::Skeleton& skeleton, double shoulder, double elbow) {
-  skin::Pose pose = skin::Pose::rest(skeleton);
-  pose.apply_local(
-      0, skin::Versor::from_trs(
-             cga::Vec3<double>(0, 0, 0),
-             cga::Quat<double>(Eigen::AngleAxisd(shoulder, Eigen::Vector3d::UnitY())), 1.0));
-  pose.apply_local(1,
-                   skin::Versor::from_trs(
-                       cga::Vec3<double>(0, 0, 0),
-                       cga::Quat<double>(Eigen::AngleAxisd(elbow, Eigen::Vector3d::UnitX())), 1.0));
-  return pose;
-}
-
 struct LiveArm {
   SoftWorld w;
   bullet::Plugin plugin{w.world};
@@ -45,7 +32,7 @@ struct LiveArm {
     body = &plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = pretension});
     skin::PoseTrack track;
     track.set_key(0, skin::Pose::rest(arm.skeleton));
-    track.set_key(1, bent(arm.skeleton, 0.7, 1.2));
+    track.set_key(1, conform::test::bent_arm_pose(arm.skeleton, 0.7, 1.2));
     track.set_key(2, skin::Pose::rest(arm.skeleton));
     body->set_keyframes(track);
     w.step(warmup);

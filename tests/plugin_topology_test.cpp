@@ -19,19 +19,6 @@ using conform::test::SoftWorld;
 
 namespace {
 
-skin::Pose swing(const skin::Skeleton& skeleton, double shoulder, double elbow) {
-  skin::Pose pose = skin::Pose::rest(skeleton);
-  pose.apply_local(
-      0, skin::Versor::from_trs(
-             cga::Vec3<double>(0, 0, 0),
-             cga::Quat<double>(Eigen::AngleAxisd(shoulder, Eigen::Vector3d::UnitY())), 1.0));
-  pose.apply_local(1,
-                   skin::Versor::from_trs(
-                       cga::Vec3<double>(0, 0, 0),
-                       cga::Quat<double>(Eigen::AngleAxisd(elbow, Eigen::Vector3d::UnitX())), 1.0));
-  return pose;
-}
-
 struct Snapshot {
   std::vector<btVector3> x, v;
   double mass = 0;
@@ -156,7 +143,7 @@ struct LiveArm {
   LiveArm() {
     body = &plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = 0.1});
     track.set_key(0, skin::Pose::rest(arm.skeleton));
-    track.set_key(2, swing(arm.skeleton, 0.8, 1.2));
+    track.set_key(2, conform::test::bent_arm_pose(arm.skeleton, 0.8, 1.2));
     body->set_keyframes(track);
     w.step(20);  // moving: every node has a velocity
   }

@@ -6,6 +6,10 @@
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
 #include <btBulletDynamicsCommon.h>
 
+#include <Eigen/Geometry>
+
+#include "conform/skin/pose.hpp"
+
 namespace conform::test {
 
 struct SoftWorld {
@@ -24,5 +28,17 @@ struct SoftWorld {
     for (int i = 0; i < n; ++i) world.stepSimulation(btScalar(dt), 1, btScalar(dt));
   }
 };
+
+/// The arm's rest pose with the shoulder turned about y and the elbow bent about x (radians).
+inline skin::Pose bent_arm_pose(const skin::Skeleton& skeleton, double shoulder, double elbow) {
+  skin::Pose pose = skin::Pose::rest(skeleton);
+  const auto turn = [](double angle, const Eigen::Vector3d& axis) {
+    return skin::Versor::from_trs(cga::Vec3<double>::Zero(),
+                                  cga::Quat<double>(Eigen::AngleAxisd(angle, axis)), 1.0);
+  };
+  pose.apply_local(0, turn(shoulder, Eigen::Vector3d::UnitY()));
+  pose.apply_local(1, turn(elbow, Eigen::Vector3d::UnitX()));
+  return pose;
+}
 
 }  // namespace conform::test

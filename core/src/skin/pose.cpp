@@ -29,26 +29,12 @@ void blend(const Pose& a, const Pose& b, double alpha, Blend mode, Pose& out) {
     out.local[i] = blend(a.local[i], b.local[i], alpha, mode);
 }
 
-namespace {
-
-// (M_a D_a)(M_b D_b) = M_a (D_a M_b D_a⁻¹) D_a D_b (versor.hpp). Conjugating by a dilation
-// scales the translation, and a motor's e∞ part −½ t R (e1∞, e2∞, e3∞, e123∞) is linear in t,
-// so D_a M_b D_a⁻¹ is M_b with those four components times d_a: no need to extract and rebuild
-// the translation as Versor::operator* does.
-Versor compose(const Versor& a, const Versor& b) {
-  cga::Motor<double> m = b.motor;
-  m.e1inf *= a.scale, m.e2inf *= a.scale, m.e3inf *= a.scale, m.e123inf *= a.scale;
-  return {a.motor * m, a.scale * b.scale};
-}
-
-}  // namespace
-
 void global_versors(const Skeleton& skeleton, const Pose& pose, std::span<Versor> global) {
   const std::size_t n = skeleton.joints.size();
   for (std::size_t i = 0; i < n; ++i) {
     const auto parent = skeleton.joints[i].parent;
-    global[i] = parent < 0 ? pose.local[i]
-                           : compose(global[static_cast<std::size_t>(parent)], pose.local[i]);
+    global[i] =
+        parent < 0 ? pose.local[i] : global[static_cast<std::size_t>(parent)] * pose.local[i];
   }
 }
 
@@ -56,7 +42,7 @@ void skinning_versors(const Skeleton& skeleton, std::span<const Versor> global,
                       std::span<Versor> out) {
   for (std::size_t n = 0; n < skeleton.bones.size(); ++n) {
     const auto& b = skeleton.bones[n];
-    out[n] = compose(global[static_cast<std::size_t>(b.joint)], b.offset);
+    out[n] = global[static_cast<std::size_t>(b.joint)] * b.offset;
   }
 }
 

@@ -53,20 +53,22 @@ struct Versor {
   Multivector<T> mv() const { return motor.mv() * Dilator<T>{scale}.mv(); }
 
   friend Versor operator*(const Versor& a, const Versor& b) {
-    // D_a M_b D_a⁻¹: same rotation, translation × d_a.
-    const Motor<T> scaled =
-        Motor<T>::from_rotation_translation(b.motor.rotation(), b.motor.translation() * a.scale);
-    return {a.motor * scaled, a.scale * b.scale};
+    return {a.motor * conjugated_by_dilation(b.motor, a.scale), a.scale * b.scale};
   }
   /// Empty when the scale is not positive and finite or the motor is not invertible.
   std::optional<Versor> inverse() const {
     if (!(scale > T(0)) || !std::isfinite(scale)) return std::nullopt;
     auto mi = motor.inverse();
     if (!mi) return std::nullopt;
-    // (M D)⁻¹ = D⁻¹ M⁻¹ = (D⁻¹ M⁻¹ D) D⁻¹: translation of M⁻¹ scaled by 1/d.
-    const Motor<T> scaled =
-        Motor<T>::from_rotation_translation(mi->rotation(), mi->translation() / scale);
-    return Versor{scaled, T(1) / scale};
+    // (M D)⁻¹ = D⁻¹ M⁻¹ = (D⁻¹ M⁻¹ D) D⁻¹.
+    return Versor{conjugated_by_dilation(*mi, T(1) / scale), T(1) / scale};
+  }
+
+  /// D M D⁻¹ for a dilation by d: the motor's e∞ part −½ t R (e1∞, e2∞, e3∞, e123∞) is linear
+  /// in t and the dilation scales t by d, so those four components are multiplied by d.
+  static Motor<T> conjugated_by_dilation(Motor<T> m, T d) {
+    m.e1inf *= d, m.e2inf *= d, m.e3inf *= d, m.e123inf *= d;
+    return m;
   }
 
   SimilarityKernel<T> kernel() const {
