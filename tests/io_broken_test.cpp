@@ -2,10 +2,14 @@
 // `conform info` command exits non-zero on them.
 #include <gtest/gtest.h>
 
+#include <csignal>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <new>
 
+#include "conform/io/crash_guard.hpp"
 #include "conform/io/import.hpp"
 
 namespace {
@@ -54,9 +58,24 @@ INSTANTIATE_TEST_SUITE_P(
       return n;
     });
 
-// Files on which assimp 5.2 itself crashes (segfault in the Collada loader on a joint index
-// out of range, heap corruption in the X loader on a vertex index out of range): with the
-// crash guard the read happens in a child process first and the caller gets an ImportError.
+// The guard itself, on work whose fate is known: a crash in the child is reported by its signal
+// and leaves the caller running; work that returns or throws is not a crash.
+TEST(IoBroken, CrashGuardReportsTheChildsSignal) {
+  EXPECT_EQ(conform::io::crash_in_child([] { std::raise(SIGSEGV); }), strsignal(SIGSEGV));
+  EXPECT_EQ(conform::io::crash_in_child([] { std::abort(); }), strsignal(SIGABRT));
+  EXPECT_EQ(conform::io::crash_in_child([] {}), "");
+  EXPECT_EQ(conform::io::crash_in_child([] { throw std::bad_alloc(); }), "");
+  // The child works on a copy: nothing it writes reaches the caller.
+  int value = 1;
+  conform::io::crash_in_child([&] { value = 2; });
+  EXPECT_EQ(value, 1);
+}
+
+// Files on which assimp 5.2 has undefined behaviour (a joint index out of range in the Collada
+// loader, a vertex index out of range in the X loader). What happens depends on the machine's
+// memory layout: a segfault or heap-corruption abort here, a std::bad_alloc caught by assimp on
+// another machine. With the crash guard either way ends in an ImportError naming the file, and
+// the caller survives.
 TEST(IoBroken, CrashGuardTurnsAssimpCrashesIntoErrors) {
   conform::io::ImportOptions o;
   o.crash_guard = true;
@@ -66,9 +85,11 @@ TEST(IoBroken, CrashGuardTurnsAssimpCrashesIntoErrors) {
       conform::io::import_model(path, o);
       ADD_FAILURE() << f;
     } catch (const ImportError& e) {
-      EXPECT_EQ(std::string(e.what()).rfind(path, 0), 0u);
-      EXPECT_NE(std::string(e.what()).find("assimp crashed reading it"), std::string::npos)
-          << e.what();
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind(path, 0), 0u) << what;
+      EXPECT_TRUE(what.find("assimp crashed reading it") != std::string::npos ||
+                  what.find("cannot be read") != std::string::npos)
+          << what;
     }
   }
   // The guard lets good files through, with the same result.

@@ -12,14 +12,7 @@
 #include <map>
 #include <unordered_map>
 
-#include <fcntl.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-
+#include "conform/io/crash_guard.hpp"
 #include "conform/mesh/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 
@@ -341,23 +334,15 @@ void pose_current(SkinnedModel& m) {
   s.write(m.mesh.current);
 }
 
-// Reads the file in a forked child; empty when the child did not crash (it may still have
+// Reads the file in a forked child first; empty when the child did not crash (it may still have
 // failed: the real read reports that), else why it crashed.
 std::string crashes_assimp(const std::string& file) {
-  std::fflush(nullptr);
-  const pid_t pid = fork();
-  if (pid < 0) return {};  // cannot fork: read in-process only
-  if (pid == 0) {
-    const int null = open("/dev/null", O_WRONLY);  // assimp's assert messages
-    if (null >= 0) dup2(null, 2);
+  const std::string signal = crash_in_child([&] {
     Assimp::Importer importer;
-    _exit(importer.ReadFile(file, import_flags()) ? 0 : 1);
-  }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) return {};
-  if (!WIFSIGNALED(status)) return {};
-  return "assimp crashed reading it (" + std::string(strsignal(WTERMSIG(status))) +
+    importer.ReadFile(file, import_flags());
+  });
+  if (signal.empty()) return {};
+  return "assimp crashed reading it (" + signal +
          "); the file is corrupt (e.g. bone or vertex indices out of range)";
 }
 
