@@ -34,6 +34,26 @@ extra_configuration() {
     -R "$regex" -E NOT_BUILT
 }
 
+# ASan reserves terabytes of address space for its shadow memory; where the machine forbids that
+# (ulimit -v, strict overcommit) every sanitized test would fail at start-up, so probe first.
+sanitizers_run() {
+  local dir
+  dir="$(mktemp -d)"
+  echo 'int main() { return 0; }' >"$dir/probe.cpp"
+  c++ -fsanitize=address,undefined "$dir/probe.cpp" -o "$dir/probe" >/dev/null 2>&1 &&
+    "$dir/probe" >/dev/null 2>&1
+  local rc=$?
+  rm -rf "$dir"
+  return $rc
+}
+
+if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SANITIZE_TESTS:-0}" == "1" ) ]] &&
+  ! sanitizers_run; then
+  echo "conform: WARNING: an ASan+UBSan program cannot start on this machine (address-space limit?);" \
+    "the sanitized core tests are skipped" >&2
+  CONFORM_SKIP_SANITIZE=1
+fi
+
 if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SANITIZE_TESTS:-0}" == "1" ) ]]; then
   echo "conform: core tests under ASan+UBSan"
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
