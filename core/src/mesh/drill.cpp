@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <deque>
 #include <numbers>
@@ -21,24 +22,6 @@ struct Axis {
     return q - q.dot(u) * u;
   }
 };
-
-// Segment p→q against triangle (a, b, c), Möller–Trumbore; true when they meet.
-bool segment_hits(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
-                  const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-  const Eigen::Vector3d d = q - p, e1 = b - a, e2 = c - a;
-  const Eigen::Vector3d h = d.cross(e2);
-  const double det = e1.dot(h);
-  if (std::abs(det) < 1e-300) return false;
-  const double inv = 1 / det;
-  const Eigen::Vector3d s = p - a;
-  const double u = inv * s.dot(h);
-  if (u < 0 || u > 1) return false;
-  const Eigen::Vector3d qv = s.cross(e1);
-  const double v = inv * d.dot(qv);
-  if (v < 0 || u + v > 1) return false;
-  const double t = inv * e2.dot(qv);
-  return t >= 0 && t <= 1;
-}
 
 // The roots α in [0, 1] of |μ + α(ν − μ)|² = r² (eqs 18–20 with α from μ), ascending.
 int edge_roots(const Eigen::Vector3d& mu, const Eigen::Vector3d& nu, double r2, double out[2]) {
@@ -65,27 +48,245 @@ double axis_distance_squared(const DrillTool& tool, const Eigen::Vector3d& x) {
   return (q - q.dot(u) * u).squaredNorm();
 }
 
-DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool,
-                  const DrillOptions& options) {
+namespace {
+
+void check_input(const SkinnedMesh& mesh, const Adjacency& adjacency, const DrillTool& tool) {
   if (!tool.tip.allFinite() || !tool.base.allFinite() || !std::isfinite(tool.radius))
     throw std::invalid_argument("drill: tip, base and radius must be finite");
   if (!(tool.radius > 0)) throw std::invalid_argument("drill: the radius must be positive");
-  const double len = (tool.tip - tool.base).norm();
-  if (!(len > 0)) throw std::invalid_argument("drill: tip and base must differ");
+  if (!((tool.tip - tool.base).norm() > 0))
+    throw std::invalid_argument("drill: tip and base must differ");
   if (!adjacency.matches(mesh))
     throw std::invalid_argument("drill: the adjacency does not describe this mesh");
   if (!mesh.current.allFinite()) throw std::invalid_argument("drill: non-finite positions");
+}
+
+// A hole's patch and what the tube needs of it.
+struct Patch {
+  std::vector<std::int32_t> faces;
+  double t = 2;                                // where the axis pierces it, from B (0) to A (1)
+  bool entering = false;                       // its pierced face's normal points against B→A
+  std::size_t added_begin = 0, added_end = 0;  // its faces in the hole change's added_faces
+  std::vector<std::int32_t> removed;           // its removed faces
+  std::vector<std::int32_t> rim;               // its rim loop, in boundary order; empty: none
+  bool cut = false;
+};
+
+DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index,
+                       const DrillTool& tool, const DrillOptions& options,
+                       const std::vector<SegmentHit>& hits);
+
+std::vector<SegmentHit> pierced_faces(const SkinnedMesh& mesh, FaceIndex* index,
+                                      const DrillTool& tool, const DrillOptions& options) {
+  if (options.search == FaceSearch::Scan) return scan_segment_hits(mesh, tool.base, tool.tip);
+  if (index) {
+    index->ensure_fitted(mesh);
+    return index->segment_hits(mesh, tool.base, tool.tip);
+  }
+  return FaceIndex(mesh).segment_hits(mesh, tool.base, tool.tip);
+}
+
+}  // namespace
+
+DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool,
+                  const DrillOptions& options) {
+  check_input(mesh, adjacency, tool);
+  return drill_impl(mesh, adjacency, nullptr, tool, options,
+                    pierced_faces(mesh, nullptr, tool, options));
+}
+
+DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex& index, const DrillTool& tool,
+                  const DrillOptions& options) {
+  check_input(mesh, adjacency, tool);
+  if (!index.matches(mesh))
+    throw std::invalid_argument("drill: the face index does not describe this mesh");
+  return drill_impl(mesh, adjacency, &index, tool, options,
+                    pierced_faces(mesh, &index, tool, options));
+}
+
+namespace {
+
+// The boundary loop the hole change `ch` (not yet applied) leaves around `hole`, as rim
+// vertices in boundary order (the surface on the left), or empty when the boundary there is
+// not one simple loop of rim vertices (new vertices on the cylinder, or snapped ones).
+template <class SideOf>
+std::vector<std::int32_t> rim_loop(const SkinnedMesh& mesh, const Adjacency& adjacency,
+                                   const TopologyChange& ch, const Patch& hole,
+                                   const SideOf& side_of) {
+  auto removed = [&](std::int32_t f) {
+    return std::binary_search(ch.removed_faces.begin(), ch.removed_faces.end(), f);
+  };
+  EdgeMap added;
+  for (std::size_t k = hole.added_begin; k < hole.added_end; ++k)
+    for (int e = 0; e < 3; ++e)
+      added.insert(ch.added_faces[k][e], ch.added_faces[k][(e + 1) % 3], 1);
+  EdgeMap next;  // (u, 0) → v for the boundary half-edge u → v
+  std::size_t count = 0;
+  std::int32_t start = -1;
+  bool simple = true;
+  auto boundary = [&](std::int32_t u, std::int32_t v) {
+    simple = simple && next.insert(u, 0, v);
+    ++count;
+    start = u;
+  };
+  // Half-edges of the clipped faces with no surviving twin, and half-edges of surviving faces
+  // whose twin was removed without replacement.
+  for (std::size_t k = hole.added_begin; k < hole.added_end; ++k)
+    for (int e = 0; e < 3; ++e) {
+      const std::int32_t u = ch.added_faces[k][e], v = ch.added_faces[k][(e + 1) % 3];
+      if (added.find(v, u) >= 0) continue;
+      const std::int32_t h = adjacency.find(v, u);
+      if (h >= 0 && !removed(h / 3)) continue;
+      boundary(u, v);
+    }
+  for (auto g : hole.removed) {
+    const Face& t = mesh.faces[static_cast<std::size_t>(g)];
+    for (int e = 0; e < 3; ++e) {
+      const std::int32_t a = t[e], b = t[(e + 1) % 3];
+      const std::int32_t h = adjacency.find(b, a);
+      if (h < 0 || removed(h / 3) || added.find(a, b) >= 0) continue;
+      boundary(b, a);
+    }
+  }
+  if (!simple || count < 3) return {};
+  std::vector<std::int32_t> loop;
+  std::int32_t v = start;
+  do {
+    if (!(v >= ch.base_vertex_count || side_of(v) == 0)) return {};  // not a rim vertex
+    loop.push_back(v);
+    v = next.find(v, 0);
+    if (v < 0) return {};
+  } while (v != start && loop.size() <= count);
+  if (loop.size() != count) return {};  // more than one loop
+  return loop;
+}
+
+// Joins consecutive holes along the axis, where the drill enters then leaves the surface, with
+// a strip of triangles between their rim loops (see drill.hpp, step 6).
+template <class Commit>
+void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis& axis,
+                const std::vector<Patch>& patches, DrillResult& result, Commit& commit) {
+  std::vector<const Patch*> cut;
+  for (const auto& p : patches)
+    if (p.cut) cut.push_back(&p);
+  std::sort(cut.begin(), cut.end(), [](const Patch* a, const Patch* b) { return a->t < b->t; });
+  // An orthonormal frame about the axis, for the rim vertices' angles.
+  int k0 = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(axis.u[k]) < std::abs(axis.u[k0])) k0 = k;
+  const Eigen::Vector3d e1 = Eigen::Vector3d::Unit(k0).cross(axis.u).normalized();
+  const Eigen::Vector3d e2 = axis.u.cross(e1);
+  auto angle = [&](std::int32_t v) {
+    const Eigen::Vector3d r = axis.radial(mesh.current.col(v));
+    return std::atan2(r.dot(e2), r.dot(e1));
+  };
+  constexpr double pi = std::numbers::pi;
+  auto wrap = [](double a) { return std::remainder(a, 2 * pi); };
+  // Cumulative turning along a closed loop from its first vertex (loop.size() + 1 values).
+  auto turning = [&](const std::vector<std::int32_t>& loop) {
+    std::vector<double> cum(loop.size() + 1, 0.0);
+    for (std::size_t k = 0; k < loop.size(); ++k)
+      cum[k + 1] = cum[k] + wrap(angle(loop[(k + 1) % loop.size()]) - angle(loop[k]));
+    return cum;
+  };
+  auto fail = [&](const std::string& why) {
+    if (!result.message.empty()) result.message += "; ";
+    result.message += why;
+  };
+  for (std::size_t i = 0; i + 1 < cut.size();) {
+    const Patch& pa = *cut[i];
+    const Patch& pb = *cut[i + 1];
+    if (!pa.entering || pb.entering) {
+      ++i;
+      continue;
+    }
+    i += 2;
+    if (pa.rim.empty() || pb.rim.empty()) {
+      fail("tube: a rim is not one simple loop of rim vertices");
+      continue;
+    }
+    // The tube runs along the entry rim against its boundary order and along the exit rim in
+    // its boundary order: both then turn the same way about the axis.
+    const std::vector<std::int32_t> A(pa.rim.rbegin(), pa.rim.rend());
+    const double a0 = angle(A[0]);
+    std::size_t j0 = 0;
+    for (std::size_t j = 1; j < pb.rim.size(); ++j)
+      if (std::abs(wrap(angle(pb.rim[j]) - a0)) < std::abs(wrap(angle(pb.rim[j0]) - a0))) j0 = j;
+    std::vector<std::int32_t> B(pb.rim.begin() + static_cast<std::ptrdiff_t>(j0), pb.rim.end());
+    B.insert(B.end(), pb.rim.begin(), pb.rim.begin() + static_cast<std::ptrdiff_t>(j0));
+    const std::vector<double> alpha = turning(A), beta = turning(B);
+    const double ta = alpha.back(), tb = beta.back();
+    if (std::abs(std::abs(ta) - 2 * pi) > 1e-6 || std::abs(ta - tb) > 1e-6) {
+      fail("tube: the rims do not wind once around the axis in matching directions");
+      continue;
+    }
+    const double sign = ta > 0 ? 1 : -1, delta = wrap(angle(B[0]) - a0);
+    const std::size_t n = A.size(), m = B.size();
+    std::vector<Face> faces;
+    faces.reserve(n + m);
+    for (std::size_t ia = 0, jb = 0; ia < n || jb < m;) {
+      const bool along_a =
+          jb == m || (ia < n && sign * alpha[ia + 1] <= sign * (delta + beta[jb + 1]));
+      if (along_a) {
+        faces.push_back({A[ia], A[(ia + 1) % n], B[jb % m]});
+        ++ia;
+      } else {
+        faces.push_back({B[(jb + 1) % m], B[jb], A[ia % n]});
+        ++jb;
+      }
+    }
+    // The strip must only add edges: along the rims the reverse of a boundary half-edge, across
+    // the tube edges that do not exist yet.
+    EdgeMap in_a;
+    for (auto v : A) in_a.insert(v, 0, 1);
+    bool ok = true;
+    for (auto v : B) ok = ok && in_a.find(v, 0) < 0;
+    for (const Face& f : faces)
+      for (int e = 0; e < 3 && ok; ++e) {
+        const std::int32_t x = f[e], y = f[(e + 1) % 3];
+        const bool across = (in_a.find(x, 0) >= 0) != (in_a.find(y, 0) >= 0);
+        ok = adjacency.find(x, y) < 0 && (!across || adjacency.find(y, x) < 0);
+      }
+    if (!ok) {
+      fail("tube: the rims share vertices or edges");
+      continue;
+    }
+    TopologyChange tube;
+    tube.base_vertex_count = mesh.vertex_count();
+    tube.base_face_count = mesh.face_count();
+    tube.added_faces = std::move(faces);
+    result.tube_faces += static_cast<std::int32_t>(tube.added_faces.size());
+    ++result.tubes;
+    commit(std::move(tube));
+  }
+}
+
+DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index,
+                       const DrillTool& tool, const DrillOptions& options,
+                       const std::vector<SegmentHit>& hits) {
+  const double len = (tool.tip - tool.base).norm();
   Axis axis{tool.base, (tool.tip - tool.base) / len, len, tool.radius * tool.radius};
   DrillResult result;
-
+  auto commit = [&](TopologyChange&& ch) {
+    apply(mesh, ch, &adjacency);
+    if (index) index->update(mesh, ch);
+    result.changes.push_back(std::move(ch));
+  };
+  // The axis parameter where it pierces face f, or −1.
   auto pierced = [&](std::int32_t f) {
     const Face& t = mesh.faces[static_cast<std::size_t>(f)];
-    return segment_hits(tool.base, tool.tip, mesh.current.col(t[0]), mesh.current.col(t[1]),
-                        mesh.current.col(t[2]));
+    double at = -1;
+    std::array<double, 3> bary{};
+    if (!segment_triangle(tool.base, tool.tip, mesh.current.col(t[0]), mesh.current.col(t[1]),
+                          mesh.current.col(t[2]), at, bary))
+      return -1.0;
+    return at;
   };
   std::vector<std::int32_t> seeds;
-  for (std::int32_t f = 0; f < mesh.face_count(); ++f)
-    if (pierced(f)) seeds.push_back(f);
+  std::vector<double> seed_t;
+  for (const SegmentHit& h : hits) seeds.push_back(h.face);
+  std::sort(seeds.begin(), seeds.end());
+  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
   if (seeds.empty()) {
     result.message = "the drill's axis does not pierce the surface";
     return result;
@@ -101,16 +302,17 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool
     double roots[2];
     return edge_roots(mu, nu, axis.r2, roots) == 2;
   };
-  // Breadth-first patches from the seeds; patch[i] lists the faces of hole i.
-  std::vector<std::vector<std::int32_t>> patches;
+  // Breadth-first patches from the seeds; patches[i].faces lists the faces of hole i.
+  std::vector<Patch> patches;
   auto walk = [&]() {
     patches.clear();
-    EdgeMap seen;
+    EdgeMap seen;  // (face, 0) → its patch
     for (auto s : seeds) {
       if (seen.find(s, 0) >= 0) continue;
+      const auto id = static_cast<std::int32_t>(patches.size());
       std::vector<std::int32_t> patch;
       std::deque<std::int32_t> queue{s};
-      seen.insert(s, 0, 1);
+      seen.insert(s, 0, id);
       while (!queue.empty()) {
         const std::int32_t f = queue.front();
         queue.pop_front();
@@ -122,12 +324,25 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool
           bool near = false;
           for (int e = 0; e < 3 && !near; ++e) near = edge_near(t[e], t[(e + 1) % 3]);
           if (!near) continue;
-          seen.insert(g, 0, 1);
+          seen.insert(g, 0, id);
           queue.push_back(g);
         }
       }
       std::sort(patch.begin(), patch.end());
-      patches.push_back(std::move(patch));
+      Patch hole;
+      hole.faces = std::move(patch);
+      patches.push_back(std::move(hole));
+    }
+    // Where the axis pierces each patch first, and whether it enters the surface there.
+    for (auto s : seeds) {
+      Patch& p = patches[static_cast<std::size_t>(seen.find(s, 0))];
+      const double at = pierced(s);
+      if (at < 0 || at >= p.t) continue;
+      p.t = at;
+      const Face& t = mesh.faces[static_cast<std::size_t>(s)];
+      const Eigen::Vector3d n = (mesh.current.col(t[1]) - mesh.current.col(t[0]))
+                                    .cross(mesh.current.col(t[2]) - mesh.current.col(t[0]));
+      p.entering = n.dot(axis.u) < 0;
     }
   };
 
@@ -135,7 +350,8 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool
   for (;;) {
     walk();
     std::vector<EdgeSplit> splits;
-    for (const auto& patch : patches) {
+    for (const auto& hole : patches) {
+      const auto& patch = hole.faces;
       int crossings = 0;
       double longest = 0;  // the longest edge of a face the rim crosses
       std::vector<EdgeSplit> patch_edges;
@@ -185,12 +401,11 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool
     for (auto s : seeds)
       if (!std::binary_search(ch.removed_faces.begin(), ch.removed_faces.end(), s))
         candidates.push_back(s);
-    apply(mesh, ch, &adjacency);
-    result.changes.push_back(std::move(ch));
+    commit(std::move(ch));
     ++result.refinements;
     seeds.clear();
     for (auto f : candidates)
-      if (pierced(f)) seeds.push_back(f);
+      if (pierced(f) >= 0) seeds.push_back(f);
     std::sort(seeds.begin(), seeds.end());
     seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
   }
@@ -198,8 +413,8 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool
   // Classify the patches' vertices: +1 outside, −1 inside, 0 on the cylinder (snapped).
   EdgeMap side;  // (vertex, 0) → side + 1
   auto side_of = [&](std::int32_t v) { return side.find(v, 0) - 1; };
-  for (const auto& patch : patches)
-    for (auto f : patch)
+  for (const auto& hole : patches)
+    for (auto f : hole.faces)
       for (auto v : mesh.faces[static_cast<std::size_t>(f)])
         if (side.find(v, 0) < 0) side.insert(v, 0, inside(v) ? 0 : 2);
   const std::int32_t nv0 = mesh.vertex_count();
@@ -212,8 +427,8 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool
                              axis.r2, roots);
     return n > 0 ? roots[0] : 0.5;
   };
-  for (const auto& patch : patches)
-    for (auto f : patch) {
+  for (const auto& hole : patches)
+    for (auto f : hole.faces) {
       const Face& t = mesh.faces[static_cast<std::size_t>(f)];
       for (int k = 0; k < 3; ++k) {
         const std::int32_t a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
@@ -246,15 +461,17 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool
            n.coefficients[1] * mesh.current.col(n.parents[1]);
   };
   std::vector<std::int32_t> removed;
-  for (const auto& patch : patches) {
+  for (auto& hole : patches) {
     bool cut_any = false;
-    for (auto f : patch) {
+    hole.added_begin = ch.added_faces.size();
+    for (auto f : hole.faces) {
       const Face& t = mesh.faces[static_cast<std::size_t>(f)];
       const int s[3] = {side_of(t[0]), side_of(t[1]), side_of(t[2])};
       const bool has_in = s[0] < 0 || s[1] < 0 || s[2] < 0;
       if (!has_in) continue;
       const bool has_out = s[0] > 0 || s[1] > 0 || s[2] > 0;
       removed.push_back(f);
+      hole.removed.push_back(f);
       cut_any = true;
       const double a0 = area(pos(t[0]), pos(t[1]), pos(t[2]));
       double kept = 0;
@@ -290,6 +507,8 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool
       }
       result.removed_area += a0 - kept;
     }
+    hole.added_end = ch.added_faces.size();
+    hole.cut = cut_any;
     result.holes += cut_any;
   }
   result.removed_area_faces = static_cast<std::int32_t>(removed.size());
@@ -300,9 +519,15 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool
     result.message = "the drill pierces the surface but removes nothing";
     return result;
   }
-  apply(mesh, ch, &adjacency);
-  result.changes.push_back(std::move(ch));
+  if (options.tube) {
+    for (auto& hole : patches)
+      if (hole.cut) hole.rim = rim_loop(mesh, adjacency, ch, hole, side_of);
+  }
+  commit(std::move(ch));
+  if (options.tube) join_holes(mesh, adjacency, axis, patches, result, commit);
   return result;
 }
+
+}  // namespace
 
 }  // namespace conform::mesh

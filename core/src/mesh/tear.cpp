@@ -32,21 +32,8 @@ struct Crossing {
 bool segment_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
                       const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                       std::array<double, 3>& bary) {
-  const Eigen::Vector3d d = q - p, e1 = b - a, e2 = c - a;
-  const Eigen::Vector3d h = d.cross(e2);
-  const double det = e1.dot(h);
-  if (!(std::abs(det) > 1e-300)) return false;
-  const double inv = 1 / det;
-  const Eigen::Vector3d s = p - a;
-  const double u = inv * s.dot(h);
-  if (u < 0 || u > 1) return false;
-  const Eigen::Vector3d qv = s.cross(e1);
-  const double v = inv * d.dot(qv);
-  if (v < 0 || u + v > 1) return false;
-  const double t = inv * e2.dot(qv);
-  if (t < 0 || t > 1) return false;
-  bary = {1 - u - v, u, v};
-  return true;
+  double t = 0;
+  return conform::mesh::segment_triangle(p, q, a, b, c, t, bary);
 }
 
 // The faces around vertex v, starting from half-edge h out of v (CCW, then CW from h if a
@@ -84,15 +71,34 @@ Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, const TearOptions& options)
     throw std::invalid_argument("tear: snap_fraction must be in (0, 0.25)");
 }
 
+Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex& index, const TearOptions& options)
+    : Tear(mesh, adjacency, options) {
+  if (!index.matches(mesh))
+    throw std::invalid_argument("tear: the face index does not describe this mesh");
+  index_ = &index;
+}
+
+void Tear::commit(TopologyChange&& change, TearStep& step) {
+  apply(mesh_, change, &adjacency_);
+  if (index_) index_->update(mesh_, change);
+  step.changes.push_back(std::move(change));
+}
+
 bool Tear::start(const ScalpelSample& s, TearStep& step) {
-  std::array<double, 3> bary{};
-  std::int32_t hit = -1;
-  for (std::int32_t f = 0; f < mesh_.face_count() && hit < 0; ++f) {
-    const Face& t = mesh_.faces[static_cast<std::size_t>(f)];
-    if (segment_triangle(s.a, s.b, mesh_.current.col(t[0]), mesh_.current.col(t[1]),
-                         mesh_.current.col(t[2]), bary))
-      hit = f;
+  SegmentHit first;
+  if (options_.search == FaceSearch::Scan) {
+    const auto hits = scan_segment_hits(mesh_, s.a, s.b);
+    if (!hits.empty()) first = hits.front();
+  } else if (index_) {
+    if (!index_->matches(mesh_))
+      throw std::invalid_argument("tear: the face index does not describe this mesh");
+    index_->ensure_fitted(mesh_);
+    first = index_->first_hit(mesh_, s.a, s.b);
+  } else {
+    first = FaceIndex(mesh_).first_hit(mesh_, s.a, s.b);
   }
+  const std::int32_t hit = first.face;
+  std::array<double, 3> bary = first.bary;
   if (hit < 0) {
     message_ = "the scalpel does not meet the surface";
     return false;
@@ -110,8 +116,7 @@ bool Tear::start(const ScalpelSample& s, TearStep& step) {
   ch.new_vertices.push_back(NewVertex::in_face(f[0], f[1], f[2], bary[0], bary[1], bary[2]));
   ch.removed_faces = {hit};
   ch.added_faces = {{f[0], f[1], s0}, {f[1], f[2], s0}, {f[2], f[0], s0}};
-  apply(mesh_, ch, &adjacency_);
-  step.changes.push_back(std::move(ch));
+  commit(std::move(ch), step);
   tip_ = s0;
   tip_neighbor_ = f[0];
   path_.push_back({s0, -1, Eigen::Vector3d::Zero()});
@@ -426,8 +431,7 @@ TearStep Tear::advance(const ScalpelSample& s) {
   std::sort(a.removed_faces.begin(), a.removed_faces.end());
   a.removed_faces.erase(std::unique(a.removed_faces.begin(), a.removed_faces.end()),
                         a.removed_faces.end());
-  apply(mesh_, a, &adjacency_);
-  step.changes.push_back(std::move(a));
+  commit(std::move(a), step);
 
   // Phase B: duplicate the interior points for the faces on the path's left, found by turning
   // counter-clockwise around each from the outgoing path edge to the incoming one (or to the
@@ -480,10 +484,7 @@ TearStep Tear::advance(const ScalpelSample& s) {
     b.removed_faces.push_back(fi);
     b.added_faces.push_back(f);
   }
-  if (!b.empty()) {
-    apply(mesh_, b, &adjacency_);
-    step.changes.push_back(std::move(b));
-  }
+  if (!b.empty()) commit(std::move(b), step);
 
   // Record the path: the old tip becomes interior, then the Q_j, then the new tip.
   path_.back().left = dups[0];
@@ -537,6 +538,7 @@ std::vector<std::pair<std::int32_t, Eigen::Vector3d>> Tear::open(double amount) 
     out.emplace_back(path_[i].left, delta[i]);
     out.emplace_back(path_[i].right, -delta[i]);
   }
+  if (index_ && !out.empty()) index_->mark_moved();
   return out;
 }
 

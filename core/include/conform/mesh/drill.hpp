@@ -1,8 +1,8 @@
 // Drilling (Algorithm 3 of the second paper), on the current positions.
 //
 // The drill is a cylinder of radius r about the axis from B (base) to A (tip).
-//   1. the faces pierced by the axis segment B→A are found (one scan of the faces: there is
-//      no spatial index yet);
+//   1. the faces pierced by the axis segment B→A are found by a segment query of a FaceIndex
+//      (FaceSearch::Scan: by one scan of every face, the oracle of tests and benchmarks);
 //   2. from each, a breadth-first walk over neighbouring faces that come within r of the
 //      axis (a vertex inside, or an edge whose projection on the plane Π through B
 //      perpendicular to the axis passes inside the disc) marks the affected patch; separate
@@ -17,9 +17,18 @@
 // Vertices closer to the cylinder than snap_fraction of an edge are taken as rim vertices (not
 // moved), so there are no slivers; the computed rim points lie on the cylinder to rounding.
 //
+//   6. optionally (DrillOptions::tube), holes made in two walls of a closed surface, one where
+//      the drill enters and the next along the axis where it leaves, are joined by a tube wall:
+//      the two rim loops are stitched by a strip of triangles that walks both loops by angle
+//      around the axis (no new vertices: the tube's corners are the rim vertices), oriented as
+//      the surface, so that a closed input stays closed. A pair whose rims are not two simple
+//      loops winding once around the axis is left open (see message).
+// Given a FaceIndex, the drill refits it first if it was marked moved and updates it for every
+// change it applies. Without one, it builds a temporary index (O(F log F)): keep an index for
+// haptic rates (see face_index.hpp for who refits when).
+//
 // Degenerate input — non-finite points or radius, r ≤ 0, A = B — throws
 // std::invalid_argument; a drill that pierces nothing returns holes = 0 and changes nothing.
-// Not done: the optional tube wall joining two holes.
 #pragma once
 
 #include <Eigen/Core>
@@ -28,6 +37,7 @@
 #include <vector>
 
 #include "conform/mesh/adjacency.hpp"
+#include "conform/mesh/face_index.hpp"
 #include "conform/mesh/topology_change.hpp"
 
 namespace conform::mesh {
@@ -42,21 +52,28 @@ struct DrillOptions {
   int min_rim_points = 24;  // the paper uses 6; 24 keeps the hole's area within 2 % of πr²
   int max_refinements = 6;
   double snap_fraction = 0.01;
+  bool tube = false;  // join entry and exit holes of a closed surface with a tube wall
+  FaceSearch search = FaceSearch::Index;
 };
 
 struct DrillResult {
-  std::vector<TopologyChange> changes;  // applied in order: refinements, then the hole
+  std::vector<TopologyChange> changes;  // applied in order: refinements, the holes, the tube
   std::int32_t holes = 0;
   std::int32_t rim_vertices = 0;          // new vertices on the cylinder
   std::int32_t snapped_rim_vertices = 0;  // existing vertices taken as rim vertices
   std::int32_t removed_area_faces = 0;    // faces removed or clipped
   double removed_area = 0;
   int refinements = 0;
+  std::int32_t tubes = 0;       // hole pairs joined by a tube wall
+  std::int32_t tube_faces = 0;  // faces of the tube walls
   std::string message;
 };
 
-/// Drills `mesh` (and keeps `adjacency` up to date).
+/// Drills `mesh` (and keeps `adjacency` up to date), with a temporary face index.
 DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool,
+                  const DrillOptions& options = {});
+/// Drills `mesh`, keeping `adjacency` and `index` (which must describe the mesh) up to date.
+DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex& index, const DrillTool& tool,
                   const DrillOptions& options = {});
 
 /// Radial distance squared of x from the drill's axis line.

@@ -1,8 +1,8 @@
 // Progressive tearing (Algorithm 2 of the second paper), on the current positions.
 //
 // The scalpel is a blade segment (a, b) sampled at times t_i. The first sample that meets the
-// surface starts the tear: its intersection S_0 is found by one scan of the faces and
-// inserted as a vertex. Every later sample i + 1:
+// surface starts the tear: its intersection S_0 (the blade's hit nearest its end point a) is
+// found by a segment query of a FaceIndex and inserted as a vertex. Every later sample i + 1:
 //   1. builds the plane Π through the tip S_i and the blade's end points at t_i+1;
 //   2. walks across faces from S_i along Π ∩ M (never scanning), in the direction of the
 //      blade, until it reaches the face the blade crosses: that point is S_i+1, and the edge
@@ -12,6 +12,12 @@
 //      inside its face), then duplicates every interior point of the path (the old tip S_i,
 //      the Q_j) for the faces on the path's left, so the tear opens there; S_i+1 is the new
 //      tip. Successive samples thus extend one continuous tear.
+// Only the start queries the index; every later step is local. Given a FaceIndex, the tear
+// refits it before its query if it was marked moved (FaceIndex::ensure_fitted), updates it for
+// every change it applies, and marks it moved when open() moves positions, so it stays in sync.
+// Without one, each start attempt builds a temporary index (O(F log F)): keep an index for
+// haptic rates. TearOptions::search = FaceSearch::Scan scans every face instead (the former
+// behaviour, kept as the oracle of tests and benchmarks).
 // Every step is one or two TopologyChanges (insert, then separate), applied at once and
 // returned so a soft body can mirror them. New vertices carry weights, UVs and normals as
 // described in topology_change.hpp.
@@ -28,6 +34,7 @@
 #include <vector>
 
 #include "conform/mesh/adjacency.hpp"
+#include "conform/mesh/face_index.hpp"
 #include "conform/mesh/topology_change.hpp"
 
 namespace conform::mesh {
@@ -40,6 +47,7 @@ struct ScalpelSample {
 struct TearOptions {
   double snap_fraction = 0.05;  // of an edge (and barycentric margin of the tip in its face)
   int max_walk_faces = 100000;  // bound of one step's walk
+  FaceSearch search = FaceSearch::Index;  // how the start finds the blade's first hit
 };
 
 struct TearStep {
@@ -51,6 +59,8 @@ class Tear {
  public:
   /// The mesh and adjacency must outlive the Tear; every change is applied to both.
   Tear(SkinnedMesh& mesh, Adjacency& adjacency, const TearOptions& options = {});
+  /// Also keeps `index` (which must describe the mesh, and outlive the Tear) in sync.
+  Tear(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex& index, const TearOptions& options = {});
 
   TearStep advance(const ScalpelSample& sample);
   /// Step 6: moves the two copies of each interior tear point apart along ± the normal of
@@ -77,9 +87,11 @@ class Tear {
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // Π's unit normal of the step
   };
   bool start(const ScalpelSample& sample, TearStep& step);
+  void commit(TopologyChange&& change, TearStep& step);  // apply, update adjacency and index
 
   SkinnedMesh& mesh_;
   Adjacency& adjacency_;
+  FaceIndex* index_ = nullptr;
   TearOptions options_;
   std::vector<PathVertex> path_;
   std::int32_t tip_ = -1;

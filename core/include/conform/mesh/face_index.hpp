@@ -1,0 +1,137 @@
+// A bounding volume hierarchy over the faces of a mesh, on its CURRENT positions, answering
+// segment queries (the scalpel's blade, the drill's axis) in O(log F + hits) instead of a scan
+// of every face.
+//
+// Why a BVH and not a uniform grid: the meshes it serves are far from uniform (the arm's
+// rounded caps and the drill's 1-to-4 refinements make faces of very different sizes, a sheet
+// is flat, a sphere is hollow), and they move every step. A BVH adapts to the face sizes, its
+// refit after a motion is one bottom-up pass that never changes its structure (a grid has to
+// re-bin every face, and its cell size and extent go stale as the mesh moves or deforms), and
+// faces can be inserted and removed locally. Leaves hold up to 8 faces (4 after a build); boxes
+// are floats rounded outward and padded, so a box test never rejects a face that the exact
+// (double) segment–triangle test accepts.
+//
+// Keeping the index in sync (the caller's duty, except where noted):
+//   - build(mesh) once per mesh state (O(F log F));
+//   - whenever the current positions move (skinning, simulation, Tear::open): refit(mesh)
+//     (O(F), structure kept), or mark_moved() to have the next operation refit before it
+//     queries (ensure_fitted); the plugin moves every vertex every step, so marking is the
+//     cheap choice there: the refit is then paid only when a tear starts or a drill runs;
+//   - after every TopologyChange applied to the mesh: update(mesh, change), with the mesh
+//     already changed (O(changed faces · depth)). Tear and drill given an index do this
+//     themselves for every change they apply; a cut (or any other change) applied by the
+//     caller must be followed by update() as well;
+//   - boxes only grow under update(): after many changes, refit() tightens them and build()
+//     restores a balanced tree.
+// Queries use the faces' exact positions at query time for the final test, and the boxes to
+// prune: they are exact provided the boxes were fitted to the current positions.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "conform/mesh/skinned_mesh.hpp"
+#include "conform/mesh/topology_change.hpp"
+
+namespace conform::mesh {
+
+struct SegmentHit {
+  std::int32_t face = -1;
+  double t = 0;                         // the point p + t (q − p), t in [0, 1]
+  std::array<double, 3> bary{0, 0, 0};  // barycentric in the face, for its corners in order
+};
+
+/// Segment p→q against triangle (a, b, c) (Möller–Trumbore, closed bounds, so a segment through
+/// an edge or a vertex meets every face sharing it). On a hit, writes the segment parameter and
+/// the barycentric coordinates. A segment in the triangle's plane (|det| ≤ 1e−300) misses.
+bool segment_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
+                      const Eigen::Vector3d& b, const Eigen::Vector3d& c, double& t,
+                      std::array<double, 3>& bary);
+
+/// Every face the segment meets, by one scan of all faces, sorted by (t, face). O(F). The
+/// brute-force oracle of FaceIndex (tests, benchmarks, FaceSearch::Scan).
+std::vector<SegmentHit> scan_segment_hits(const SkinnedMesh& mesh, const Eigen::Vector3d& p,
+                                          const Eigen::Vector3d& q);
+
+/// How an operation finds the faces a segment meets: through a FaceIndex (the default), or
+/// by one scan of every face (the former behaviour, kept as an oracle for tests and for the
+/// benchmarks' same-run comparison).
+enum class FaceSearch { Index, Scan };
+
+class FaceIndex {
+ public:
+  FaceIndex() = default;
+  explicit FaceIndex(const SkinnedMesh& mesh) { build(mesh); }
+
+  /// Builds the tree (median splits of the face centroids along the longest axis) and fits it.
+  void build(const SkinnedMesh& mesh);
+  /// Refits every box to the current positions, bottom-up; the tree is kept. O(F).
+  void refit(const SkinnedMesh& mesh);
+  /// The positions moved: the next ensure_fitted() refits.
+  void mark_moved() { fitted_ = false; }
+  void ensure_fitted(const SkinnedMesh& mesh) {
+    if (!fitted_) refit(mesh);
+  }
+  bool fitted() const { return fitted_; }
+  /// Mirrors apply(mesh, change) (call it after the apply, with the changed mesh): faces in
+  /// removed slots leave the tree, added faces enter it where their boxes grow it least, and
+  /// faces moved by the swap-with-last step are renamed. Throws std::invalid_argument when the
+  /// change was not computed for the mesh this index describes.
+  void update(const SkinnedMesh& mesh, const TopologyChange& change);
+
+  /// True when the index describes a mesh of this face count (a cheap sanity check).
+  bool matches(const SkinnedMesh& mesh) const { return face_count() == mesh.face_count(); }
+  std::int32_t face_count() const { return static_cast<std::int32_t>(leaf_of_.size()); }
+  std::int32_t node_count() const { return static_cast<std::int32_t>(nodes_.size()); }
+  /// Longest root-to-leaf path (1 for a lone leaf, 0 when empty). O(nodes).
+  int depth() const;
+
+  /// Every face the segment p→q meets, sorted by (t, face); `out` is overwritten.
+  void segment_hits(const SkinnedMesh& mesh, const Eigen::Vector3d& p, const Eigen::Vector3d& q,
+                    std::vector<SegmentHit>& out) const;
+  std::vector<SegmentHit> segment_hits(const SkinnedMesh& mesh, const Eigen::Vector3d& p,
+                                       const Eigen::Vector3d& q) const {
+    std::vector<SegmentHit> out;
+    segment_hits(mesh, p, q, out);
+    return out;
+  }
+  /// The hit nearest p (smallest t, then lowest face), or face −1.
+  SegmentHit first_hit(const SkinnedMesh& mesh, const Eigen::Vector3d& p,
+                       const Eigen::Vector3d& q) const;
+
+  /// Checks the structure against the mesh: every face in exactly one leaf, parents and
+  /// children consistent, every face's box inside its leaf's and every child's inside its
+  /// parent's (on the current positions). Empty when sound, else the first problem. O(F).
+  std::string validate(const SkinnedMesh& mesh) const;
+
+ private:
+  static constexpr int kLeafBuild = 4, kLeafCapacity = 8;
+  struct Box {
+    float lo[3], hi[3];
+  };
+  struct Node {
+    Box box;
+    std::int32_t child = -1;   // internal: children at child and child + 1; leaf: −1
+    std::int32_t parent = -1;  // −1 at the root
+    std::int32_t first = 0;    // leaf: its block of kLeafCapacity slots in items_
+    std::int32_t count = 0;    // leaf: faces in the block
+  };
+  Box face_box(const SkinnedMesh& mesh, std::int32_t f) const;
+  void fit_leaf(const SkinnedMesh& mesh, std::int32_t n);
+  std::int32_t new_leaf_block();
+  void insert(const SkinnedMesh& mesh, std::int32_t f);
+  void erase(std::int32_t f);
+  void rename(std::int32_t from, std::int32_t to);
+  void split_leaf(const SkinnedMesh& mesh, std::int32_t n, std::int32_t extra);
+  void grow_up(std::int32_t n, const Box& box);
+
+  std::vector<Node> nodes_;            // children always after their parent
+  std::vector<std::int32_t> items_;    // leaf blocks of face slots
+  std::vector<std::int32_t> leaf_of_;  // face slot → its leaf
+  bool fitted_ = false;
+};
+
+}  // namespace conform::mesh

@@ -1,0 +1,548 @@
+#include "conform/mesh/face_index.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+
+namespace conform::mesh {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Floats rounded outward, so that a float box always contains the doubles it was made from.
+float round_down(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) > x) f = std::nextafter(f, -kInf);
+  return f;
+}
+float round_up(double x) {
+  float f = static_cast<float>(x);
+  if (static_cast<double>(f) < x) f = std::nextafter(f, kInf);
+  return f;
+}
+
+bool less_hit(const SegmentHit& a, const SegmentHit& b) {
+  return a.t < b.t || (a.t == b.t && a.face < b.face);
+}
+
+}  // namespace
+
+bool segment_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
+                      const Eigen::Vector3d& b, const Eigen::Vector3d& c, double& t,
+                      std::array<double, 3>& bary) {
+  const Eigen::Vector3d d = q - p, e1 = b - a, e2 = c - a;
+  const Eigen::Vector3d h = d.cross(e2);
+  const double det = e1.dot(h);
+  if (!(std::abs(det) > 1e-300)) return false;
+  const double inv = 1 / det;
+  const Eigen::Vector3d s = p - a;
+  const double u = inv * s.dot(h);
+  if (u < 0 || u > 1) return false;
+  const Eigen::Vector3d qv = s.cross(e1);
+  const double v = inv * d.dot(qv);
+  if (v < 0 || u + v > 1) return false;
+  const double tt = inv * e2.dot(qv);
+  if (tt < 0 || tt > 1) return false;
+  t = tt;
+  bary = {1 - u - v, u, v};
+  return true;
+}
+
+std::vector<SegmentHit> scan_segment_hits(const SkinnedMesh& mesh, const Eigen::Vector3d& p,
+                                          const Eigen::Vector3d& q) {
+  std::vector<SegmentHit> out;
+  for (std::int32_t f = 0; f < mesh.face_count(); ++f) {
+    const Face& t = mesh.faces[static_cast<std::size_t>(f)];
+    SegmentHit h{f};
+    if (segment_triangle(p, q, mesh.current.col(t[0]), mesh.current.col(t[1]),
+                         mesh.current.col(t[2]), h.t, h.bary))
+      out.push_back(h);
+  }
+  std::sort(out.begin(), out.end(), less_hit);
+  return out;
+}
+
+namespace {
+
+// A box from double bounds: padded by 1e−6 of its largest extent and 1e−9 of its largest
+// coordinate (so that rounding in the slab test never rejects a point of a face), rounded out.
+template <class Box>
+Box make_box(const double lo[3], const double hi[3]) {
+  Box b;
+  if (!(lo[0] <= hi[0])) {  // empty (or NaN)
+    for (int k = 0; k < 3; ++k) b.lo[k] = kInf, b.hi[k] = -kInf;
+    return b;
+  }
+  double ext = 0, mag = 0;
+  for (int k = 0; k < 3; ++k) {
+    ext = std::max(ext, hi[k] - lo[k]);
+    mag = std::max({mag, std::abs(lo[k]), std::abs(hi[k])});
+  }
+  const double pad = 1e-6 * ext + 1e-9 * mag;
+  for (int k = 0; k < 3; ++k) {
+    b.lo[k] = round_down(lo[k] - pad);
+    b.hi[k] = round_up(hi[k] + pad);
+  }
+  return b;
+}
+
+template <class Box>
+void grow(Box& b, const Box& o) {
+  for (int k = 0; k < 3; ++k) {
+    b.lo[k] = std::min(b.lo[k], o.lo[k]);
+    b.hi[k] = std::max(b.hi[k], o.hi[k]);
+  }
+}
+
+template <class Box>
+bool empty(const Box& b) {
+  return !(b.lo[0] <= b.hi[0]);
+}
+
+template <class Box>
+double area(const Box& b) {
+  if (empty(b)) return 0;
+  const double x = double(b.hi[0]) - b.lo[0], y = double(b.hi[1]) - b.lo[1],
+               z = double(b.hi[2]) - b.lo[2];
+  return 2 * (x * y + y * z + z * x);
+}
+
+template <class Box>
+bool contains(const Box& outer, const Box& inner) {
+  if (empty(inner)) return true;
+  for (int k = 0; k < 3; ++k)
+    if (inner.lo[k] < outer.lo[k] || inner.hi[k] > outer.hi[k]) return false;
+  return true;
+}
+
+// The segment p + t d, t in [0, tmax], against a box; on a hit, the parameter where it enters.
+struct Ray {
+  Eigen::Vector3d p, d, inv;
+  Ray(const Eigen::Vector3d& a, const Eigen::Vector3d& b) : p(a), d(b - a) {
+    for (int k = 0; k < 3; ++k) inv[k] = d[k] != 0 ? 1 / d[k] : 0;
+  }
+  template <class Box>
+  bool hits(const Box& b, double tmax, double& enter) const {
+    if (empty(b)) return false;
+    double t0 = 0, t1 = tmax;
+    for (int k = 0; k < 3; ++k) {
+      const double lo = b.lo[k], hi = b.hi[k];
+      if (d[k] == 0) {
+        if (p[k] < lo || p[k] > hi) return false;
+        continue;
+      }
+      double ta = (lo - p[k]) * inv[k], tb = (hi - p[k]) * inv[k];
+      if (ta > tb) std::swap(ta, tb);
+      t0 = std::max(t0, ta);
+      t1 = std::min(t1, tb);
+      if (t0 > t1) return false;
+    }
+    enter = t0;
+    return true;
+  }
+};
+
+}  // namespace
+
+FaceIndex::Box FaceIndex::face_box(const SkinnedMesh& mesh, std::int32_t f) const {
+  const Face& t = mesh.faces[static_cast<std::size_t>(f)];
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) lo[k] = hi[k] = mesh.current(k, t[0]);
+  for (int c = 1; c < 3; ++c)
+    for (int k = 0; k < 3; ++k) {
+      const double x = mesh.current(k, t[c]);
+      lo[k] = std::min(lo[k], x);
+      hi[k] = std::max(hi[k], x);
+    }
+  return make_box<Box>(lo, hi);
+}
+
+void FaceIndex::fit_leaf(const SkinnedMesh& mesh, std::int32_t n) {
+  Node& node = nodes_[static_cast<std::size_t>(n)];
+  double lo[3] = {std::numeric_limits<double>::infinity(), 0, 0}, hi[3] = {-lo[0], 0, 0};
+  if (node.count > 0) {
+    const Face& t0 =
+        mesh.faces[static_cast<std::size_t>(items_[static_cast<std::size_t>(node.first)])];
+    for (int k = 0; k < 3; ++k) lo[k] = hi[k] = mesh.current(k, t0[0]);
+  }
+  for (std::int32_t i = 0; i < node.count; ++i) {
+    const Face& t =
+        mesh.faces[static_cast<std::size_t>(items_[static_cast<std::size_t>(node.first + i)])];
+    for (auto v : t)
+      for (int k = 0; k < 3; ++k) {
+        const double x = mesh.current(k, v);
+        lo[k] = std::min(lo[k], x);
+        hi[k] = std::max(hi[k], x);
+      }
+  }
+  node.box = make_box<Box>(lo, hi);
+}
+
+std::int32_t FaceIndex::new_leaf_block() {
+  const auto first = static_cast<std::int32_t>(items_.size());
+  items_.resize(items_.size() + kLeafCapacity, -1);
+  return first;
+}
+
+void FaceIndex::build(const SkinnedMesh& mesh) {
+  const std::int32_t nf = mesh.face_count();
+  nodes_.clear();
+  items_.clear();
+  leaf_of_.assign(static_cast<std::size_t>(nf), -1);
+  fitted_ = true;
+  if (nf == 0) return;
+  std::vector<std::int32_t> order(static_cast<std::size_t>(nf));
+  std::iota(order.begin(), order.end(), 0);
+  std::vector<std::array<float, 3>> centroid(static_cast<std::size_t>(nf));
+  for (std::int32_t f = 0; f < nf; ++f) {
+    const Face& t = mesh.faces[static_cast<std::size_t>(f)];
+    for (int k = 0; k < 3; ++k)
+      centroid[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)] = static_cast<float>(
+          (mesh.current(k, t[0]) + mesh.current(k, t[1]) + mesh.current(k, t[2])) / 3);
+  }
+  const std::size_t leaves = static_cast<std::size_t>(nf) / kLeafBuild + 1;
+  nodes_.reserve(2 * leaves + 16);
+  items_.reserve(kLeafCapacity * leaves + 64);
+  struct Task {
+    std::int32_t node, begin, end;
+  };
+  std::vector<Task> stack{{0, 0, nf}};
+  nodes_.push_back({});
+  while (!stack.empty()) {
+    const Task task = stack.back();
+    stack.pop_back();
+    const std::int32_t n = task.end - task.begin;
+    if (n <= kLeafBuild) {
+      const std::int32_t first = new_leaf_block();
+      Node& leaf = nodes_[static_cast<std::size_t>(task.node)];
+      leaf.first = first;
+      leaf.count = n;
+      for (std::int32_t i = 0; i < n; ++i) {
+        const std::int32_t f = order[static_cast<std::size_t>(task.begin + i)];
+        items_[static_cast<std::size_t>(first + i)] = f;
+        leaf_of_[static_cast<std::size_t>(f)] = task.node;
+      }
+      continue;
+    }
+    float lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
+    for (std::int32_t i = task.begin; i < task.end; ++i) {
+      const auto& c = centroid[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], c[static_cast<std::size_t>(k)]);
+        hi[k] = std::max(hi[k], c[static_cast<std::size_t>(k)]);
+      }
+    }
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+      if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    const std::int32_t mid = task.begin + n / 2;
+    std::nth_element(
+        order.begin() + task.begin, order.begin() + mid, order.begin() + task.end,
+        [&](std::int32_t a, std::int32_t b) {
+          const float ca = centroid[static_cast<std::size_t>(a)][static_cast<std::size_t>(axis)],
+                      cb = centroid[static_cast<std::size_t>(b)][static_cast<std::size_t>(axis)];
+          return ca < cb || (ca == cb && a < b);
+        });
+    const auto child = static_cast<std::int32_t>(nodes_.size());
+    nodes_[static_cast<std::size_t>(task.node)].child = child;
+    Node c;
+    c.parent = task.node;
+    nodes_.push_back(c);
+    nodes_.push_back(c);
+    stack.push_back({child + 1, mid, task.end});
+    stack.push_back({child, task.begin, mid});
+  }
+  refit(mesh);
+}
+
+void FaceIndex::refit(const SkinnedMesh& mesh) {
+  // Children come after their parents, so one backward pass fits every node.
+  for (std::size_t i = nodes_.size(); i-- > 0;) {
+    Node& n = nodes_[i];
+    if (n.child < 0) {
+      fit_leaf(mesh, static_cast<std::int32_t>(i));
+    } else {
+      n.box = nodes_[static_cast<std::size_t>(n.child)].box;
+      grow(n.box, nodes_[static_cast<std::size_t>(n.child + 1)].box);
+    }
+  }
+  fitted_ = true;
+}
+
+void FaceIndex::grow_up(std::int32_t n, const Box& box) {
+  for (; n >= 0; n = nodes_[static_cast<std::size_t>(n)].parent)
+    grow(nodes_[static_cast<std::size_t>(n)].box, box);
+}
+
+void FaceIndex::insert(const SkinnedMesh& mesh, std::int32_t f) {
+  const Box fb = face_box(mesh, f);
+  if (nodes_.empty()) {
+    Node root;
+    root.box = fb;
+    root.first = new_leaf_block();
+    nodes_.push_back(root);
+  }
+  std::int32_t n = 0;
+  for (;;) {
+    Node& node = nodes_[static_cast<std::size_t>(n)];
+    grow(node.box, fb);
+    if (node.child < 0) break;
+    // Descend where the box grows least (surface area), ties to the smaller box.
+    double best_cost = 0, best_area = 0;
+    std::int32_t best = -1;
+    for (std::int32_t c = node.child; c < node.child + 2; ++c) {
+      Box u = nodes_[static_cast<std::size_t>(c)].box;
+      const double before = area(u);
+      grow(u, fb);
+      const double after = area(u), cost = after - before;
+      if (best < 0 || cost < best_cost || (cost == best_cost && after < best_area))
+        best = c, best_cost = cost, best_area = after;
+    }
+    n = best;
+  }
+  Node& leaf = nodes_[static_cast<std::size_t>(n)];
+  if (leaf.count < kLeafCapacity) {
+    items_[static_cast<std::size_t>(leaf.first + leaf.count++)] = f;
+    leaf_of_[static_cast<std::size_t>(f)] = n;
+    return;
+  }
+  split_leaf(mesh, n, f);
+}
+
+void FaceIndex::split_leaf(const SkinnedMesh& mesh, std::int32_t n, std::int32_t extra) {
+  std::array<std::int32_t, kLeafCapacity + 1> faces{};
+  std::array<std::array<double, 3>, kLeafCapacity + 1> centroid{};
+  const Node old = nodes_[static_cast<std::size_t>(n)];
+  for (int i = 0; i < kLeafCapacity; ++i)
+    faces[static_cast<std::size_t>(i)] = items_[static_cast<std::size_t>(old.first + i)];
+  faces[kLeafCapacity] = extra;
+  double lo[3] = {std::numeric_limits<double>::infinity(), 0, 0}, hi[3] = {-lo[0], 0, 0};
+  for (int k = 1; k < 3; ++k) lo[k] = lo[0], hi[k] = hi[0];
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const Face& t = mesh.faces[static_cast<std::size_t>(faces[i])];
+    for (int k = 0; k < 3; ++k) {
+      const double c = (mesh.current(k, t[0]) + mesh.current(k, t[1]) + mesh.current(k, t[2])) / 3;
+      centroid[i][static_cast<std::size_t>(k)] = c;
+      lo[k] = std::min(lo[k], c);
+      hi[k] = std::max(hi[k], c);
+    }
+  }
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+  std::array<int, kLeafCapacity + 1> idx{};
+  std::iota(idx.begin(), idx.end(), 0);
+  std::sort(idx.begin(), idx.end(), [&](int a, int b) {
+    return centroid[static_cast<std::size_t>(a)][static_cast<std::size_t>(axis)] <
+           centroid[static_cast<std::size_t>(b)][static_cast<std::size_t>(axis)];
+  });
+  const auto child = static_cast<std::int32_t>(nodes_.size());
+  Node c0, c1;
+  c0.parent = c1.parent = n;
+  c0.first = old.first;
+  c1.first = new_leaf_block();
+  constexpr int half = (kLeafCapacity + 1) / 2;
+  for (int i = 0; i < kLeafCapacity + 1; ++i) {
+    const std::int32_t f = faces[static_cast<std::size_t>(idx[static_cast<std::size_t>(i)])];
+    Node& c = i < half ? c0 : c1;
+    items_[static_cast<std::size_t>(c.first + c.count++)] = f;
+    leaf_of_[static_cast<std::size_t>(f)] = i < half ? child : child + 1;
+  }
+  for (int i = half; i < kLeafCapacity; ++i) items_[static_cast<std::size_t>(c0.first + i)] = -1;
+  nodes_.push_back(c0);
+  nodes_.push_back(c1);
+  Node& node = nodes_[static_cast<std::size_t>(n)];
+  node.child = child;
+  node.first = -1;
+  node.count = 0;
+  fit_leaf(mesh, child);
+  fit_leaf(mesh, child + 1);
+  // The children's pads may reach a hair beyond the grown box: keep the ancestors enclosing.
+  grow_up(n, nodes_[static_cast<std::size_t>(child)].box);
+  grow_up(n, nodes_[static_cast<std::size_t>(child + 1)].box);
+}
+
+void FaceIndex::erase(std::int32_t f) {
+  const std::int32_t n = leaf_of_[static_cast<std::size_t>(f)];
+  Node& leaf = nodes_[static_cast<std::size_t>(n)];
+  for (std::int32_t i = 0; i < leaf.count; ++i)
+    if (items_[static_cast<std::size_t>(leaf.first + i)] == f) {
+      items_[static_cast<std::size_t>(leaf.first + i)] =
+          items_[static_cast<std::size_t>(leaf.first + leaf.count - 1)];
+      items_[static_cast<std::size_t>(leaf.first + --leaf.count)] = -1;
+      break;
+    }
+  leaf_of_[static_cast<std::size_t>(f)] = -1;
+}
+
+void FaceIndex::rename(std::int32_t from, std::int32_t to) {
+  const std::int32_t n = leaf_of_[static_cast<std::size_t>(from)];
+  const Node& leaf = nodes_[static_cast<std::size_t>(n)];
+  for (std::int32_t i = 0; i < leaf.count; ++i)
+    if (items_[static_cast<std::size_t>(leaf.first + i)] == from)
+      items_[static_cast<std::size_t>(leaf.first + i)] = to;
+  leaf_of_[static_cast<std::size_t>(to)] = n;
+  leaf_of_[static_cast<std::size_t>(from)] = -1;
+}
+
+void FaceIndex::update(const SkinnedMesh& mesh, const TopologyChange& change) {
+  const auto& removed = change.removed_faces;
+  const auto& added = change.added_faces;
+  const std::size_t filled = std::min(removed.size(), added.size());
+  const auto final_count = static_cast<std::int64_t>(change.base_face_count) +
+                           static_cast<std::int64_t>(added.size()) -
+                           static_cast<std::int64_t>(removed.size());
+  if (change.base_face_count != face_count() || final_count != mesh.face_count())
+    throw std::invalid_argument(
+        "FaceIndex::update: the change was not computed for the indexed mesh (apply it first)");
+  // The same slot order as apply(): refilled slots, appended faces, then swap-with-last.
+  for (std::size_t k = 0; k < filled; ++k) erase(removed[k]);
+  for (std::size_t k = 0; k < filled; ++k) insert(mesh, removed[k]);
+  for (std::size_t k = filled; k < added.size(); ++k) {
+    leaf_of_.push_back(-1);
+    insert(mesh, static_cast<std::int32_t>(leaf_of_.size()) - 1);
+  }
+  for (std::size_t k = removed.size(); k-- > filled;) {
+    const std::int32_t slot = removed[k];
+    const std::int32_t last = face_count() - 1;
+    erase(slot);
+    if (slot != last) rename(last, slot);
+    leaf_of_.pop_back();
+  }
+}
+
+int FaceIndex::depth() const {
+  if (nodes_.empty()) return 0;
+  std::vector<int> d(nodes_.size(), 1);
+  int deepest = 1;
+  for (std::size_t i = 1; i < nodes_.size(); ++i) {
+    d[i] = d[static_cast<std::size_t>(nodes_[i].parent)] + 1;
+    deepest = std::max(deepest, d[i]);
+  }
+  return deepest;
+}
+
+void FaceIndex::segment_hits(const SkinnedMesh& mesh, const Eigen::Vector3d& p,
+                             const Eigen::Vector3d& q, std::vector<SegmentHit>& out) const {
+  out.clear();
+  if (nodes_.empty()) return;
+  const Ray ray(p, q);
+  std::vector<std::int32_t> stack;
+  stack.reserve(64);
+  stack.push_back(0);
+  while (!stack.empty()) {
+    const Node& n = nodes_[static_cast<std::size_t>(stack.back())];
+    stack.pop_back();
+    double enter = 0;
+    if (!ray.hits(n.box, 1.0, enter)) continue;
+    if (n.child >= 0) {
+      stack.push_back(n.child + 1);
+      stack.push_back(n.child);
+      continue;
+    }
+    for (std::int32_t i = 0; i < n.count; ++i) {
+      const std::int32_t f = items_[static_cast<std::size_t>(n.first + i)];
+      const Face& t = mesh.faces[static_cast<std::size_t>(f)];
+      SegmentHit h{f};
+      if (segment_triangle(p, q, mesh.current.col(t[0]), mesh.current.col(t[1]),
+                           mesh.current.col(t[2]), h.t, h.bary))
+        out.push_back(h);
+    }
+  }
+  std::sort(out.begin(), out.end(), less_hit);
+}
+
+SegmentHit FaceIndex::first_hit(const SkinnedMesh& mesh, const Eigen::Vector3d& p,
+                                const Eigen::Vector3d& q) const {
+  SegmentHit best;
+  if (nodes_.empty()) return best;
+  const Ray ray(p, q);
+  double tmax = 1;
+  struct Entry {
+    std::int32_t node;
+    double enter;
+  };
+  std::vector<Entry> stack;
+  stack.reserve(64);
+  double enter = 0;
+  if (ray.hits(nodes_[0].box, tmax, enter)) stack.push_back({0, enter});
+  while (!stack.empty()) {
+    const Entry e = stack.back();
+    stack.pop_back();
+    if (e.enter > tmax) continue;
+    const Node& n = nodes_[static_cast<std::size_t>(e.node)];
+    if (n.child >= 0) {
+      double t0 = 0, t1 = 0;
+      const bool h0 = ray.hits(nodes_[static_cast<std::size_t>(n.child)].box, tmax, t0);
+      const bool h1 = ray.hits(nodes_[static_cast<std::size_t>(n.child + 1)].box, tmax, t1);
+      // The nearer child is popped first.
+      if (h0 && h1) {
+        if (t0 <= t1) {
+          stack.push_back({n.child + 1, t1});
+          stack.push_back({n.child, t0});
+        } else {
+          stack.push_back({n.child, t0});
+          stack.push_back({n.child + 1, t1});
+        }
+      } else if (h0) {
+        stack.push_back({n.child, t0});
+      } else if (h1) {
+        stack.push_back({n.child + 1, t1});
+      }
+      continue;
+    }
+    for (std::int32_t i = 0; i < n.count; ++i) {
+      const std::int32_t f = items_[static_cast<std::size_t>(n.first + i)];
+      const Face& t = mesh.faces[static_cast<std::size_t>(f)];
+      SegmentHit h{f};
+      if (segment_triangle(p, q, mesh.current.col(t[0]), mesh.current.col(t[1]),
+                           mesh.current.col(t[2]), h.t, h.bary) &&
+          (best.face < 0 || less_hit(h, best))) {
+        best = h;
+        tmax = h.t;
+      }
+    }
+  }
+  return best;
+}
+
+std::string FaceIndex::validate(const SkinnedMesh& mesh) const {
+  if (face_count() != mesh.face_count()) return "face count differs from the mesh's";
+  std::vector<int> seen(leaf_of_.size(), 0);
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    const Node& n = nodes_[i];
+    if (i > 0 && (n.parent < 0 || static_cast<std::size_t>(n.parent) >= i))
+      return "node " + std::to_string(i) + ": bad parent";
+    if (n.child >= 0) {
+      if (static_cast<std::size_t>(n.child) <= i ||
+          static_cast<std::size_t>(n.child) + 1 >= nodes_.size())
+        return "node " + std::to_string(i) + ": bad children";
+      for (int c = 0; c < 2; ++c) {
+        const Node& ch = nodes_[static_cast<std::size_t>(n.child + c)];
+        if (ch.parent != static_cast<std::int32_t>(i))
+          return "node " + std::to_string(i) + ": child's parent differs";
+        if (fitted_ && !contains(n.box, ch.box))
+          return "node " + std::to_string(i) + ": child box outside";
+      }
+      continue;
+    }
+    if (n.count < 0 || n.count > kLeafCapacity) return "leaf " + std::to_string(i) + ": bad count";
+    for (std::int32_t k = 0; k < n.count; ++k) {
+      const std::int32_t f = items_[static_cast<std::size_t>(n.first + k)];
+      if (f < 0 || f >= face_count()) return "leaf " + std::to_string(i) + ": face out of range";
+      if (seen[static_cast<std::size_t>(f)]++) return "face " + std::to_string(f) + " twice";
+      if (leaf_of_[static_cast<std::size_t>(f)] != static_cast<std::int32_t>(i))
+        return "face " + std::to_string(f) + ": leaf_of differs";
+      if (fitted_ && !contains(n.box, face_box(mesh, f)))
+        return "face " + std::to_string(f) + ": box outside its leaf";
+    }
+  }
+  for (std::size_t f = 0; f < seen.size(); ++f)
+    if (!seen[f]) return "face " + std::to_string(f) + " in no leaf";
+  return {};
+}
+
+}  // namespace conform::mesh
