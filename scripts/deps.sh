@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libomp-dev
   libcli11-dev nlohmann-json3-dev
   gnuplot-nox  # conform run draws its PNG plots with it
+  libcgal-dev  # optional: the cut's caps (constrained Delaunay) and the cut benchmark's CGAL clip
 )
 
 missing=()

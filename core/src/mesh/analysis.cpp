@@ -1,6 +1,7 @@
 #include "conform/mesh/analysis.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <tuple>
 
@@ -48,8 +49,17 @@ double signed_volume(const SkinnedMesh& mesh, std::span<const std::int32_t> face
 }
 
 double bounding_diagonal(const SkinnedMesh& mesh) {
-  if (mesh.current.cols() == 0) return 0;
-  return (mesh.current.rowwise().maxCoeff() - mesh.current.rowwise().minCoeff()).norm();
+  const Eigen::Index n = mesh.current.cols();
+  if (n == 0) return 0;
+  // One pass over the columns (Eigen's rowwise reductions walk the 3 × N matrix row by row).
+  const double* p = mesh.current.data();
+  double lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
+  for (Eigen::Index i = 1; i < n; ++i) {
+    const double* q = p + 3 * i;
+    for (int k = 0; k < 3; ++k) lo[k] = std::min(lo[k], q[k]), hi[k] = std::max(hi[k], q[k]);
+  }
+  return std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                   (hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
 
 std::string MeshReport::summary() const {
@@ -141,24 +151,37 @@ std::vector<std::int32_t> Pieces::faces_of(std::int32_t p) const {
 }
 
 Pieces label_pieces(const SkinnedMesh& mesh) {
-  std::vector<std::int32_t> parent(static_cast<std::size_t>(mesh.vertex_count()));
+  // Union–find over the vertices where every root is the lowest vertex of its set: linking
+  // always hangs the higher root under the lowest, and path halving only shortcuts to
+  // ancestors, so parent[v] < v for every non-root v. One increasing pass then compresses
+  // every path completely.
+  const auto nv = static_cast<std::size_t>(mesh.vertex_count());
+  std::vector<std::int32_t> parent(nv);
   std::iota(parent.begin(), parent.end(), 0);
+  std::int32_t* const par = parent.data();
+  auto find = [par](std::int32_t x) {
+    while (par[x] != x) x = par[x] = par[par[x]];
+    return x;
+  };
   for (const Face& f : mesh.faces) {
-    const std::int32_t a = find_root(parent, f[0]);
-    const std::int32_t b = find_root(parent, f[1]);
-    const std::int32_t c = find_root(parent, f[2]);
-    parent[static_cast<std::size_t>(b)] = a;
-    parent[static_cast<std::size_t>(c)] = a;
-    parent[static_cast<std::size_t>(find_root(parent, c))] = a;
+    std::int32_t a = find(f[0]), b = find(f[1]), c = find(f[2]);
+    if (a == b && b == c) continue;
+    const std::int32_t r = std::min(a, std::min(b, c));
+    par[a] = r, par[b] = r, par[c] = r;
   }
+  for (std::size_t v = 0; v < nv; ++v) par[v] = par[par[v]];
   Pieces p;
   p.face_piece.resize(mesh.faces.size());
-  std::vector<std::int32_t> label(parent.size(), -1);
+  std::vector<std::int32_t> label(nv, -1);
+  std::int32_t* const lab = label.data();
+  std::int32_t* const out = p.face_piece.data();
+  std::int32_t count = 0;
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
-    const auto r = static_cast<std::size_t>(find_root(parent, mesh.faces[f][0]));
-    if (label[r] < 0) label[r] = p.count++;
-    p.face_piece[f] = label[r];
+    std::int32_t& l = lab[par[mesh.faces[f][0]]];
+    if (l < 0) l = count++;
+    out[f] = l;
   }
+  p.count = count;
   return p;
 }
 

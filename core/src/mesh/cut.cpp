@@ -36,79 +36,6 @@ std::int32_t root(std::vector<std::int32_t>& p, std::int32_t x) {
   return x;
 }
 
-// Ear clipping of a simple polygon given in 2D, keeping its orientation (each output triangle
-// turns the same way as the polygon). False when no ear can be found (not simple).
-bool ear_clip(const std::vector<Eigen::Vector2d>& p, std::vector<std::array<int, 3>>& out) {
-  const int n = static_cast<int>(p.size());
-  if (n < 3) return false;
-  double area = 0;
-  for (int i = 0; i < n; ++i) {
-    const auto& a = p[static_cast<std::size_t>(i)];
-    const auto& b = p[static_cast<std::size_t>((i + 1) % n)];
-    area += a.x() * b.y() - a.y() * b.x();
-  }
-  const double o = area > 0 ? 1.0 : -1.0;
-  auto cross = [&](int a, int b, int c) {
-    const Eigen::Vector2d u = p[static_cast<std::size_t>(b)] - p[static_cast<std::size_t>(a)];
-    const Eigen::Vector2d w = p[static_cast<std::size_t>(c)] - p[static_cast<std::size_t>(a)];
-    return o * (u.x() * w.y() - u.y() * w.x());
-  };
-  std::vector<int> idx(static_cast<std::size_t>(n));
-  std::iota(idx.begin(), idx.end(), 0);
-  double scale = 0;
-  for (const auto& q : p) scale = std::max(scale, q.cwiseAbs().maxCoeff());
-  const double eps = 1e-14 * scale * scale;
-  while (idx.size() > 3) {
-    const int m = static_cast<int>(idx.size());
-    bool clipped = false;
-    for (int i = 0; i < m && !clipped; ++i) {
-      const int a = idx[static_cast<std::size_t>((i + m - 1) % m)],
-                b = idx[static_cast<std::size_t>(i)],
-                c = idx[static_cast<std::size_t>((i + 1) % m)];
-      if (cross(a, b, c) <= eps) continue;  // reflex or flat: not an ear
-      bool inside = false;
-      for (int j = 0; j < m && !inside; ++j) {
-        const int q = idx[static_cast<std::size_t>(j)];
-        if (q == a || q == b || q == c) continue;
-        if (p[static_cast<std::size_t>(q)] == p[static_cast<std::size_t>(a)] ||
-            p[static_cast<std::size_t>(q)] == p[static_cast<std::size_t>(b)] ||
-            p[static_cast<std::size_t>(q)] == p[static_cast<std::size_t>(c)])
-          continue;
-        inside = cross(a, b, q) >= 0 && cross(b, c, q) >= 0 && cross(c, a, q) >= 0;
-      }
-      if (inside) continue;
-      out.push_back({a, b, c});
-      idx.erase(idx.begin() + i);
-      clipped = true;
-    }
-    if (!clipped) return false;
-  }
-  if (cross(idx[0], idx[1], idx[2]) > eps) {
-    out.push_back({idx[0], idx[1], idx[2]});
-    return true;
-  }
-  // The last three are collinear (collinear boundary points, e.g. along a flat face): the
-  // middle one b lies on the diagonal (a, c); flip that diagonal with the triangle across it,
-  // (a, c, d) → (a, b, d), (b, c, d).
-  for (int r = 0; r < 3; ++r) {
-    const int a = idx[static_cast<std::size_t>(r)], b = idx[static_cast<std::size_t>((r + 1) % 3)],
-              c = idx[static_cast<std::size_t>((r + 2) % 3)];
-    const Eigen::Vector2d ac = p[static_cast<std::size_t>(c)] - p[static_cast<std::size_t>(a)];
-    const double along = ac.dot(p[static_cast<std::size_t>(b)] - p[static_cast<std::size_t>(a)]);
-    if (!(along > 0 && along < ac.squaredNorm())) continue;  // b is not between a and c
-    for (auto& t : out)
-      for (int k = 0; k < 3; ++k)
-        if (t[static_cast<std::size_t>(k)] == a && t[static_cast<std::size_t>((k + 1) % 3)] == c) {
-          const int d = t[static_cast<std::size_t>((k + 2) % 3)];
-          if (cross(a, b, d) <= eps || cross(b, c, d) <= eps) return false;
-          t = {a, b, d};
-          out.push_back({b, c, d});
-          return true;
-        }
-  }
-  return false;
-}
-
 }  // namespace
 
 void classify_vertices(const SkinnedMesh& mesh, const cga::Plane<double>& plane_in,
@@ -160,17 +87,48 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     result.message = "the plane does not cross the mesh";
     return result;
   }
-  for (const Face& f : mesh.faces)
-    for (auto v : f)
-      if (v < 0 || v >= nv0) throw std::invalid_argument("cut: face index out of range");
+  // One pass over the faces: index check, and the faces that need work — those not strictly
+  // on one side (crossed, or touching the plane) — in increasing order. The rest only tell
+  // which sides have faces.
+  const auto nf = static_cast<std::size_t>(nf0);
+  const Face* const faces = mesh.faces.data();
+  std::int8_t* const sd = side.data();
+  std::vector<std::int32_t> work;
+  work.reserve(256);
+  bool face_pos = false, face_neg = false;
+  auto scan = [nf, nv0, faces, sd](std::vector<std::int32_t>& out, bool& pos, bool& neg) {
+    out.clear();
+    // A face is strictly on one side when the OR of its vertices' side codes is one code.
+    int any = 0;
+    const auto bound = static_cast<std::uint32_t>(nv0);
+    for (std::size_t fi = 0; fi < nf; ++fi) {
+      const Face& f = faces[fi];
+      const auto a = static_cast<std::uint32_t>(f[0]), b = static_cast<std::uint32_t>(f[1]),
+                 c = static_cast<std::uint32_t>(f[2]);
+      if ((a >= bound) | (b >= bound) | (c >= bound))
+        throw std::invalid_argument("cut: face index out of range");
+      // side & 3 is 1 (+), 3 (−) or 0 (on the plane): codes 2, 8 and 1.
+      const int code = (1 << (sd[a] & 3)) | (1 << (sd[b] & 3)) | (1 << (sd[c] & 3));
+      if (code == 2 || code == 8) {
+        any |= code;
+        continue;
+      }
+      out.push_back(static_cast<std::int32_t>(fi));
+    }
+    pos = (any & 2) != 0, neg = (any & 8) != 0;
+  };
+  scan(work, face_pos, face_neg);
 
-  // Snap crossings that fall too close to an end of their edge onto that end.
+  // Snap crossings that fall too close to an end of their edge onto that end (only faces in
+  // `work` have crossed edges). Snapping can make faces strictly on one side touch the plane:
+  // then the faces are scanned again.
   const double snap = options.snap_fraction;
-  for (const Face& f : mesh.faces)
+  for (const std::int32_t fi : work) {
+    const Face& f = faces[fi];
     for (int k = 0; k < 3; ++k) {
       const std::int32_t a = std::min(f[k], f[(k + 1) % 3]), b = std::max(f[k], f[(k + 1) % 3]);
-      auto& sa = side[static_cast<std::size_t>(a)];
-      auto& sb = side[static_cast<std::size_t>(b)];
+      std::int8_t& sa = sd[a];
+      std::int8_t& sb = sd[b];
       if (sa * sb >= 0) continue;
       const double da = dist[static_cast<std::size_t>(a)], db = dist[static_cast<std::size_t>(b)];
       const double t = da / (da - db);
@@ -179,10 +137,15 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
       else if (t > 1 - snap)
         sb = 0, ++result.snapped_vertices;
     }
+  }
+  if (result.snapped_vertices > 0) scan(work, face_pos, face_neg);
 
   TopologyChange& ch = result.change;
   EdgeMap crossing;  // (lower, higher) vertex → crossing vertex id
+  crossing.reserve(2 * work.size());
+  ch.new_vertices.reserve(2 * work.size());
   std::vector<Eigen::Vector3d> xpos;
+  xpos.reserve(work.size());
   auto cross_vertex = [&](std::int32_t u, std::int32_t w) {
     const std::int32_t a = std::min(u, w), b = std::max(u, w);
     std::int32_t id = crossing.find(a, b);
@@ -201,13 +164,14 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   };
 
   std::vector<Pending> pending;
+  pending.reserve(3 * work.size());
   std::vector<std::pair<std::int32_t, std::int32_t>>
       on_plane;  // (vertex on the plane, pending index)
   std::vector<std::int32_t> split;
-  bool face_pos = false, face_neg = false;
+  split.reserve(work.size());
   const Eigen::Vector3d n = plane.normal();
-  for (std::int32_t fi = 0; fi < nf0; ++fi) {
-    const Face& f = mesh.faces[static_cast<std::size_t>(fi)];
+  for (const std::int32_t fi : work) {
+    const Face& f = faces[fi];
     const std::int8_t s[3] = {side[static_cast<std::size_t>(f[0])],
                               side[static_cast<std::size_t>(f[1])],
                               side[static_cast<std::size_t>(f[2])]};
@@ -346,13 +310,16 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   auto is_loop_vertex = [&](std::int32_t v) {
     return v >= nv0 ? v < nv0 + nx : side[static_cast<std::size_t>(v)] == 0;
   };
-  EdgeMap plus_edges;
+  EdgeMap plus_edges;  // only edges between loop vertices matter
+  plus_edges.reserve(pending.size());
   for (const Pending& p : pending)
     if (p.side > 0)
-      for (int k = 0; k < 3; ++k) plus_edges.insert(p.pre[k], p.pre[(k + 1) % 3], 1);
+      for (int k = 0; k < 3; ++k)
+        if (is_loop_vertex(p.pre[k]) && is_loop_vertex(p.pre[(k + 1) % 3]))
+          plus_edges.insert(p.pre[k], p.pre[(k + 1) % 3], 1);
   // Copy maps: pre-remap id → the id each side uses; conflicting entries make a loop ambiguous.
   EdgeMap copy_of;  // key (vertex, side + 1) → id
-  std::vector<char> ambiguous_flag;
+  copy_of.reserve(pending.size());
   std::vector<std::int32_t> ambiguous;
   for (const Pending& p : pending)
     for (int k = 0; k < 3; ++k) {
@@ -363,6 +330,7 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     }
   std::sort(ambiguous.begin(), ambiguous.end());
   EdgeMap next;  // boundary edge u → v, keyed (u, 0)
+  next.reserve(pending.size() / 2);
   std::vector<std::int32_t> starts;
   bool branching = false;
   for (const Pending& p : pending) {
@@ -375,11 +343,17 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     }
   }
   EdgeMap visited;
+  visited.reserve(starts.size());
   std::vector<std::string> problems;
+  // Every closed, unambiguous loop goes into one triangulation of the section, in the plane's
+  // frame (e1, e2, n), so that loops inside loops make holes and islands.
   const Eigen::Vector3d e1 = n.unitOrthogonal(), e2 = n.cross(e1);
+  std::vector<std::int32_t> ids;  // the section's vertices, loops concatenated
+  std::vector<std::vector<Eigen::Vector2d>> loops2;
+  std::vector<std::int32_t> loop;
   for (auto s0 : starts) {
     if (visited.find(s0, 0) >= 0) continue;
-    std::vector<std::int32_t> loop;
+    loop.clear();
     std::int32_t u = s0;
     bool closed = false;
     while (u >= 0 && visited.find(u, 0) < 0) {
@@ -400,47 +374,41 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
           "a cut loop through a vertex where the surface touches the plane in several fans");
       continue;
     }
-    // The positive piece's cap turns opposite to its boundary: triangulate the reversed loop.
-    std::reverse(loop.begin(), loop.end());
-    std::vector<Eigen::Vector2d> p2;
+    auto& p2 = loops2.emplace_back();
+    p2.reserve(loop.size());
     for (auto v : loop) {
       const Eigen::Vector3d x = pos(v);
       p2.emplace_back(x.dot(e1), x.dot(e2));
     }
-    double area = 0;
-    for (std::size_t i = 0; i < p2.size(); ++i) {
-      const auto& a = p2[i];
-      const auto& b = p2[(i + 1) % p2.size()];
-      area += a.x() * b.y() - a.y() * b.x();
-    }
-    std::vector<std::array<int, 3>> tris;
-    if (area >= 0) {
-      // A reversed boundary turning counter-clockwise about n bounds a hole of the section
-      // (a loop inside another); holes are not bridged here.
-      problems.push_back("a cut loop that is a hole in the cross-section");
-      continue;
-    }
-    if (!ear_clip(p2, tris)) {
-      problems.push_back("a cut loop whose projection is not a simple polygon");
-      continue;
-    }
-    ++result.capped_loops;
-    for (const auto& t : tris) {
-      Face plus, minus;
-      for (int k = 0; k < 3; ++k) {
-        const std::int32_t v = loop[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])];
-        plus[k] = copy_of.find(v, 2);
-        minus[2 - k] = copy_of.find(v, 0);
+    ids.insert(ids.end(), loop.begin(), loop.end());
+  }
+  if (!loops2.empty()) {
+    const SectionTriangulation section = triangulate_section(loops2, options.cap_triangulator);
+    if (!section.ok()) {
+      problems.push_back(section.problem);
+    } else {
+      result.capped_loops = static_cast<std::int32_t>(loops2.size());
+      for (auto d : section.depth) result.nested_loops += d > 0;
+      // Section triangles turn counter-clockwise about n: the negative piece's cap faces +n
+      // as they are, the positive piece's is reversed.
+      ch.added_faces.reserve(ch.added_faces.size() + 2 * section.triangles.size());
+      for (const auto& t : section.triangles) {
+        Face plus, minus;
+        for (int k = 0; k < 3; ++k) {
+          const std::int32_t v = ids[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])];
+          plus[2 - k] = copy_of.find(v, 2);
+          minus[k] = copy_of.find(v, 0);
+        }
+        if (plus[0] >= 0 && plus[1] >= 0 && plus[2] >= 0) {
+          ch.added_faces.push_back(plus);
+          result.added_side.push_back(1);
+        }
+        if (minus[0] >= 0 && minus[1] >= 0 && minus[2] >= 0) {
+          ch.added_faces.push_back(minus);
+          result.added_side.push_back(-1);
+        }
+        ++result.cap_faces;
       }
-      if (plus[0] >= 0 && plus[1] >= 0 && plus[2] >= 0) {
-        ch.added_faces.push_back(plus);
-        result.added_side.push_back(1);
-      }
-      if (minus[0] >= 0 && minus[1] >= 0 && minus[2] >= 0) {
-        ch.added_faces.push_back(minus);
-        result.added_side.push_back(-1);
-      }
-      ++result.cap_faces;
     }
   }
   if (!problems.empty()) result.message = "not capped: " + problems.front();

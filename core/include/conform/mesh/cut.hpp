@@ -10,7 +10,10 @@
 //   4. separate the sides: the positive side keeps the original vertices, every fan of faces
 //      around a loop vertex beyond the first gets a duplicate (normally: the negative side);
 //      faces lying in the plane go to the side opposite their normal;
-//   5. optionally cap every closed cut loop with an ear-clipped triangulation, both sides.
+//   5. optionally cap the cross-section, both sides: every closed cut loop goes into one
+//      triangulation of the section (cap.hpp: CGAL's constrained Delaunay triangulation when
+//      built with CGAL, else ear clipping with holes bridged), filled by nesting parity, so
+//      loops inside loops (a hollow tube, a torus cut through its hole) give rings.
 // Pieces are then the connected components (label_pieces), so one plane may give many.
 //
 // Degenerate input: a non-finite or zero-normal plane, or non-finite positions, throw
@@ -24,6 +27,7 @@
 
 #include "conform/cga/plane.hpp"
 #include "conform/mesh/analysis.hpp"
+#include "conform/mesh/cap.hpp"
 #include "conform/mesh/topology_change.hpp"
 
 namespace conform::mesh {
@@ -37,6 +41,7 @@ struct CutOptions {
   double snap_fraction = 0.01;    // of an edge's length
   bool cap = false;
   Predicates predicates = Predicates::Cga;
+  SectionTriangulator cap_triangulator = SectionTriangulator::Best;
 };
 
 enum class CutStatus { Cut, Missed };
@@ -49,8 +54,9 @@ struct CutResult {
   std::int32_t snapped_vertices = 0;  // vertices taken as on the plane by step 2
   std::int32_t loops = 0;             // closed cut loops found (when capping)
   std::int32_t capped_loops = 0;
-  std::int32_t cap_faces = 0;  // per side
-  std::string message;         // why a loop was not capped, when one was not
+  std::int32_t nested_loops = 0;  // capped loops inside another loop (holes, islands)
+  std::int32_t cap_faces = 0;     // per side
+  std::string message;            // why a loop was not capped, when one was not
 };
 
 /// Step 1 alone (exposed for benchmarks): signed distances of the current positions.

@@ -1,0 +1,54 @@
+// Triangulation of a planar cross-section bounded by closed loops: the caps of a cut.
+//
+// The section is the set of points of odd nesting depth among the loops — inside an outer
+// loop but not inside one of its holes, inside an island within a hole, and so on — so a
+// hollow tube cut across gives a ring, and loops side by side give separate discs. Loops are
+// polygons in the plane, each vertex listed once, in any orientation; they must not cross or
+// touch one another or themselves.
+//
+// Two triangulators:
+//   ConstrainedDelaunay  CGAL's 2D constrained Delaunay triangulation of every loop edge
+//                        (exact predicates), faces kept by nesting parity (a walk from the
+//                        infinite face that flips parity across each loop edge). Available
+//                        when Conform was built with CGAL (libcgal-dev; an optional
+//                        dependency, see has_cgal_triangulator()).
+//   EarClipping          nesting depths by point-in-polygon tests, each hole joined to the
+//                        loop around it by a bridge to a vertex it sees, then ear clipping of
+//                        each merged polygon. Always available; the fallback.
+// Neither adds vertices: every triangle joins three loop vertices.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace conform::mesh {
+
+enum class SectionTriangulator { Best, ConstrainedDelaunay, EarClipping };
+
+struct SectionTriangulation {
+  /// Counter-clockwise triangles; indices into the loops' vertices concatenated in order.
+  std::vector<std::array<std::int32_t, 3>> triangles;
+  std::vector<std::int32_t> depth;  // nesting depth of each loop (0: outermost)
+  std::string problem;              // empty on success; then `triangles` is empty
+  bool ok() const { return problem.empty(); }
+};
+
+/// Triangulates the section bounded by `loops` with `method` (Best: constrained Delaunay
+/// when available, else ear clipping). Requesting ConstrainedDelaunay without CGAL reports
+/// a problem.
+SectionTriangulation triangulate_section(const std::vector<std::vector<Eigen::Vector2d>>& loops,
+                                         SectionTriangulator method = SectionTriangulator::Best);
+
+/// True when this build has CGAL's constrained Delaunay triangulation.
+bool has_cgal_triangulator();
+
+namespace detail {
+// The CGAL path (cap_cgal.cpp); returns false with `problem` set when CGAL is not built in.
+bool cdt_section(const std::vector<std::vector<Eigen::Vector2d>>& loops, SectionTriangulation& out);
+bool cdt_available();
+}  // namespace detail
+
+}  // namespace conform::mesh
