@@ -1,0 +1,272 @@
+// Caps of cuts whose cross-section has nested loops (a hollow tube, a torus cut through its
+// hole's plane, a tube inside a tube), with both section triangulators, and the section
+// triangulation itself against exact areas and triangle counts.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "conform/mesh/analysis.hpp"
+#include "conform/mesh/cap.hpp"
+#include "conform/mesh/cut.hpp"
+#include "conform/mesh/primitives.hpp"
+
+using namespace conform;
+using namespace conform::mesh;
+using Plane = cga::Plane<double>;
+using Loops = std::vector<std::vector<Eigen::Vector2d>>;
+
+namespace {
+
+// A closed surface of revolution about z for each closed profile (ρ > 0, z), `segments`
+// around; each component oriented outward (flipped if its volume came out negative), with
+// the primitives' height weights so that cuts blend skinning data.
+SkinnedMesh revolve(const std::vector<std::vector<Eigen::Vector2d>>& profiles, int segments) {
+  SkinnedMesh m;
+  std::vector<Eigen::Vector3d> pts;
+  for (const auto& prof : profiles) {
+    const auto base = static_cast<std::int32_t>(pts.size());
+    const auto np = static_cast<std::int32_t>(prof.size());
+    for (std::int32_t j = 0; j < np; ++j)
+      for (int s = 0; s < segments; ++s) {
+        const double a = 2 * M_PI * s / segments;
+        pts.emplace_back(prof[static_cast<std::size_t>(j)].x() * std::cos(a),
+                         prof[static_cast<std::size_t>(j)].x() * std::sin(a),
+                         prof[static_cast<std::size_t>(j)].y());
+      }
+    const std::size_t first = m.faces.size();
+    auto id = [&](std::int32_t j, int s) { return base + (j % np) * segments + s % segments; };
+    for (std::int32_t j = 0; j < np; ++j)
+      for (int s = 0; s < segments; ++s) {
+        m.faces.push_back({id(j, s), id(j, s + 1), id(j + 1, s + 1)});
+        m.faces.push_back({id(j, s), id(j + 1, s + 1), id(j + 1, s)});
+      }
+    double v = 0;
+    for (std::size_t f = first; f < m.faces.size(); ++f) {
+      const Face& t = m.faces[f];
+      v += pts[static_cast<std::size_t>(t[0])].dot(
+          pts[static_cast<std::size_t>(t[1])].cross(pts[static_cast<std::size_t>(t[2])]));
+    }
+    if (v < 0)
+      for (std::size_t f = first; f < m.faces.size(); ++f) std::swap(m.faces[f][1], m.faces[f][2]);
+  }
+  m.rest.resize(3, static_cast<Eigen::Index>(pts.size()));
+  for (std::size_t i = 0; i < pts.size(); ++i) m.rest.col(static_cast<Eigen::Index>(i)) = pts[i];
+  m.current = m.rest;
+  assign_height_weights(m, 0.3, 0.7, 0.1);
+  return m;
+}
+
+// A rectangle [r0, r1] × [z0, z1] in the (ρ, z) half plane, n points per side.
+std::vector<Eigen::Vector2d> rectangle(double r0, double r1, double z0, double z1, int n) {
+  std::vector<Eigen::Vector2d> p;
+  for (int i = 0; i < n; ++i) p.emplace_back(r0 + (r1 - r0) * i / n, z0);
+  for (int i = 0; i < n; ++i) p.emplace_back(r1, z0 + (z1 - z0) * i / n);
+  for (int i = 0; i < n; ++i) p.emplace_back(r1 - (r1 - r0) * i / n, z1);
+  for (int i = 0; i < n; ++i) p.emplace_back(r0, z1 - (z1 - z0) * i / n);
+  return p;
+}
+
+std::vector<Eigen::Vector2d> circle(double cx, double cz, double r, int n) {
+  std::vector<Eigen::Vector2d> p;
+  for (int i = 0; i < n; ++i)
+    p.emplace_back(cx + r * std::cos(2 * M_PI * i / n), cz + r * std::sin(2 * M_PI * i / n));
+  return p;
+}
+
+SkinnedMesh thick_tube() {
+  return revolve({rectangle(0.3, 0.5, 0.0, 1.0, 12)}, 48);
+}
+SkinnedMesh torus() {
+  return revolve({circle(0.6, 0.5, 0.2, 24)}, 48);
+}
+SkinnedMesh tube_in_tube() {
+  return revolve({rectangle(0.45, 0.6, 0.0, 1.0, 10), rectangle(0.15, 0.3, 0.1, 0.9, 10)}, 40);
+}
+
+// Every piece closed, manifold and oriented, with positive volume; the volumes add up to the
+// input's to 1e-9 relative; the pieces' areas less the caps' add up to the input's.
+void expect_closed_pieces(const SkinnedMesh& in, const SkinnedMesh& m, const CutOutcome& out,
+                          const std::string& what) {
+  const double v0 = signed_volume(in);
+  double v = 0;
+  for (std::int32_t p = 0; p < out.pieces.count; ++p) {
+    SkinnedMesh piece = m;
+    piece.faces.clear();
+    for (auto f : out.pieces.faces_of(p))
+      piece.faces.push_back(m.faces[static_cast<std::size_t>(f)]);
+    const MeshReport r = check_mesh(piece, 1e-14 * std::pow(bounding_diagonal(in), 2));
+    EXPECT_TRUE(r.indices_valid) << what;
+    EXPECT_TRUE(r.closed()) << what << " piece " << p << ": " << r.summary();
+    EXPECT_TRUE(r.manifold()) << what << " piece " << p << ": " << r.summary();
+    EXPECT_TRUE(r.oriented()) << what << " piece " << p << ": " << r.summary();
+    EXPECT_EQ(r.tiny_faces, 0) << what;
+    const double vp = signed_volume(piece);
+    EXPECT_GT(vp, 0) << what << " piece " << p;
+    v += vp;
+  }
+  EXPECT_NEAR(v, v0, 1e-9 * std::abs(v0)) << what;
+  double cap_area = 0;
+  const auto nadded = static_cast<std::int32_t>(out.result.change.added_faces.size());
+  for (std::int32_t k = nadded - 2 * out.result.cap_faces; k < nadded; ++k) {
+    const Face& f = out.result.change.added_faces[static_cast<std::size_t>(k)];
+    const Eigen::Vector3d a = m.current.col(f[0]);
+    cap_area += 0.5 * (m.current.col(f[1]) - a).cross(m.current.col(f[2]) - a).norm();
+  }
+  EXPECT_NEAR(surface_area(m) - cap_area, surface_area(in), 1e-9 * surface_area(in)) << what;
+}
+
+std::vector<SectionTriangulator> triangulators() {
+  std::vector<SectionTriangulator> t = {SectionTriangulator::EarClipping};
+  if (has_cgal_triangulator()) t.push_back(SectionTriangulator::ConstrainedDelaunay);
+  return t;
+}
+const char* name(SectionTriangulator t) {
+  return t == SectionTriangulator::EarClipping ? "ear clipping" : "constrained Delaunay";
+}
+
+double polygon_area(const std::vector<Eigen::Vector2d>& p) {
+  double a = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    a += p[i].x() * p[(i + 1) % p.size()].y() - p[i].y() * p[(i + 1) % p.size()].x();
+  return 0.5 * a;
+}
+
+}  // namespace
+
+TEST(Section, NestedLoopsAreasAndCounts) {
+  // An outer square, a hole in it, an island in the hole: any orientations.
+  Loops loops = {rectangle(0, 4, 0, 4, 3), circle(2, 2, 1.5, 17), rectangle(1.5, 2.5, 1.5, 2.5, 2)};
+  std::reverse(loops[2].begin(), loops[2].end());
+  std::size_t nv = 0;
+  for (const auto& l : loops) nv += l.size();
+  const double expected = std::abs(polygon_area(loops[0])) - std::abs(polygon_area(loops[1])) +
+                          std::abs(polygon_area(loops[2]));
+  std::vector<Eigen::Vector2d> all;
+  for (const auto& l : loops) all.insert(all.end(), l.begin(), l.end());
+  for (const auto method : triangulators()) {
+    const SectionTriangulation s = triangulate_section(loops, method);
+    ASSERT_TRUE(s.ok()) << name(method) << ": " << s.problem;
+    EXPECT_EQ(s.depth, (std::vector<std::int32_t>{0, 1, 2})) << name(method);
+    double area = 0;
+    for (const auto& t : s.triangles) {
+      const double a =
+          0.5 *
+          ((all[static_cast<std::size_t>(t[1])] - all[static_cast<std::size_t>(t[0])]).x() *
+               (all[static_cast<std::size_t>(t[2])] - all[static_cast<std::size_t>(t[0])]).y() -
+           (all[static_cast<std::size_t>(t[1])] - all[static_cast<std::size_t>(t[0])]).y() *
+               (all[static_cast<std::size_t>(t[2])] - all[static_cast<std::size_t>(t[0])]).x());
+      EXPECT_GT(a, 0) << name(method) << ": a triangle turns clockwise";
+      area += a;
+    }
+    EXPECT_NEAR(area, expected, 1e-12 * expected) << name(method);
+    // Two regions: the ring with one hole (V + 2H − 2 triangles) and the island (V − 2).
+    const std::size_t ring = loops[0].size() + loops[1].size() + 2 - 2,
+                      island = loops[2].size() - 2;
+    EXPECT_EQ(s.triangles.size(), ring + island) << name(method);
+    (void)nv;
+  }
+}
+
+TEST(Section, SideBySideAndDegenerateLoops) {
+  const Loops two = {circle(0, 0, 1, 12), circle(3, 0, 1, 12)};
+  for (const auto method : triangulators()) {
+    const SectionTriangulation s = triangulate_section(two, method);
+    ASSERT_TRUE(s.ok()) << s.problem;
+    EXPECT_EQ(s.triangles.size(), 20u) << name(method);
+    EXPECT_EQ(s.depth, (std::vector<std::int32_t>{0, 0}));
+    EXPECT_FALSE(triangulate_section({{{0, 0}, {1, 0}}}, method).ok()) << name(method);
+    EXPECT_FALSE(triangulate_section({{{0, 0}, {1, 0}, {NAN, 1}}}, method).ok()) << name(method);
+  }
+  if (has_cgal_triangulator()) {
+    // Crossing loops are reported, not triangulated.
+    const SectionTriangulation s = triangulate_section({circle(0, 0, 1, 12), circle(1, 0, 1, 12)},
+                                                       SectionTriangulator::ConstrainedDelaunay);
+    EXPECT_FALSE(s.ok());
+    EXPECT_TRUE(s.triangles.empty());
+  } else {
+    EXPECT_FALSE(triangulate_section(two, SectionTriangulator::ConstrainedDelaunay).ok());
+  }
+}
+
+TEST(CapNested, HollowTubeCutAcross) {
+  const SkinnedMesh in = thick_tube();
+  ASSERT_TRUE(check_mesh(in).closed());
+  ASSERT_GT(signed_volume(in), 0);
+  for (const auto method : triangulators()) {
+    SkinnedMesh m = in;
+    Adjacency adj(m);
+    const auto out = cut(m, adj, Plane::from_normal_point({0.2, -0.1, 1}, {0.01, 0.02, 0.43}),
+                         {.cap = true, .cap_triangulator = method});
+    ASSERT_EQ(out.result.status, CutStatus::Cut);
+    EXPECT_EQ(out.result.loops, 2) << name(method);
+    EXPECT_EQ(out.result.capped_loops, 2) << name(method) << ": " << out.result.message;
+    EXPECT_EQ(out.result.nested_loops, 1) << name(method);
+    EXPECT_EQ(out.pieces.count, 2);
+    expect_closed_pieces(in, m, out, std::string("hollow tube, ") + name(method));
+  }
+}
+
+TEST(CapNested, TorusCutThroughItsHolesPlane) {
+  const SkinnedMesh in = torus();
+  for (const auto method : triangulators()) {
+    SkinnedMesh m = in;
+    Adjacency adj(m);
+    const auto out = cut(m, adj, Plane::from_normal_point({0.05, 0.02, 1}, {0, 0, 0.51}),
+                         {.cap = true, .cap_triangulator = method});
+    ASSERT_EQ(out.result.status, CutStatus::Cut);
+    EXPECT_EQ(out.result.loops, 2) << name(method);
+    EXPECT_EQ(out.result.capped_loops, 2) << name(method) << ": " << out.result.message;
+    EXPECT_EQ(out.result.nested_loops, 1) << name(method);
+    EXPECT_EQ(out.pieces.count, 2);
+    expect_closed_pieces(in, m, out, std::string("torus, ") + name(method));
+  }
+}
+
+TEST(CapNested, TubeInsideTubeHasAnIslandInAHole) {
+  const SkinnedMesh in = tube_in_tube();
+  for (const auto method : triangulators()) {
+    SkinnedMesh m = in;
+    Adjacency adj(m);
+    const auto out = cut(m, adj, Plane::from_normal_point({-0.1, 0.15, 1}, {0, 0, 0.52}),
+                         {.cap = true, .cap_triangulator = method});
+    ASSERT_EQ(out.result.status, CutStatus::Cut);
+    EXPECT_EQ(out.result.loops, 4) << name(method);
+    EXPECT_EQ(out.result.capped_loops, 4) << name(method) << ": " << out.result.message;
+    EXPECT_EQ(out.result.nested_loops, 3) << name(method);
+    EXPECT_EQ(out.pieces.count, 4);
+    expect_closed_pieces(in, m, out, std::string("tube in tube, ") + name(method));
+  }
+}
+
+TEST(CapNested, PropertyRandomPlanes) {
+  // Random planes through the hollow shapes: whenever every loop was capped, the pieces are
+  // closed and keep the volume; most cuts must be capped whole.
+  const std::vector<std::pair<std::string, SkinnedMesh>> models = {
+      {"hollow tube", thick_tube()}, {"torus", torus()}, {"tube in tube", tube_in_tube()}};
+  std::mt19937 rng(2024);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(-0.4, 0.4);
+  for (const auto method : triangulators()) {
+    int cuts = 0, capped = 0, nested = 0;
+    for (const auto& [model, in] : models)
+      for (int trial = 0; trial < 60; ++trial) {
+        SkinnedMesh m = in;
+        Adjacency adj(m);
+        const Eigen::Vector3d n(0.3 * g(rng), 0.3 * g(rng), 1.0);
+        const Plane p = Plane::from_normal_point(n, {u(rng), u(rng), 0.5 + u(rng)});
+        const auto out = cut(m, adj, p, {.cap = true, .cap_triangulator = method});
+        if (out.result.status != CutStatus::Cut) continue;
+        ++cuts;
+        if (out.result.capped_loops != out.result.loops) continue;
+        ++capped;
+        nested += out.result.nested_loops > 0;
+        expect_closed_pieces(in, m, out,
+                             model + " trial " + std::to_string(trial) + ", " + name(method));
+        if (testing::Test::HasFailure()) return;
+      }
+    EXPECT_GT(cuts, 150) << name(method);
+    EXPECT_GT(capped, 0.9 * cuts) << name(method);
+    EXPECT_GT(nested, 60) << name(method);
+  }
+}
