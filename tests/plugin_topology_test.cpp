@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 
+#include "conform/bullet/convert.hpp"
 #include "conform/bullet/plugin.hpp"
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/procedural_arm.hpp"
@@ -30,6 +31,7 @@ Snapshot snapshot(const bullet::SkinnedSoftBody& body) {
   Snapshot s;
   for (std::int32_t i = 0; i < body.vertex_count(); ++i) {
     const auto& node = body.body_of(i)->m_nodes[body.node_of(i)];
+    EXPECT_FALSE(body.detached(i));  // the snapshots are taken before any drill
     s.x.push_back(node.m_x);
     s.v.push_back(node.m_v);
   }
@@ -44,6 +46,12 @@ void expect_conserved(const bullet::SkinnedSoftBody& body, const Snapshot& befor
                       const std::vector<mesh::TopologyChange>& changes, const char* what) {
   const auto old = static_cast<std::int32_t>(before.x.size());
   for (std::int32_t i = 0; i < old; ++i) {
+    if (body.detached(i)) {  // left Bullet with its state (and mass) unchanged
+      ASSERT_EQ(body.body_of(i), nullptr);
+      ASSERT_TRUE(conform::bullet::to_bt(body.position(i)) == before.x[std::size_t(i)]);
+      ASSERT_TRUE(conform::bullet::to_bt(body.velocity(i)) == before.v[std::size_t(i)]);
+      continue;
+    }
     const auto& node = body.body_of(i)->m_nodes[body.node_of(i)];
     ASSERT_TRUE(node.m_x == before.x[std::size_t(i)]) << what << " vertex " << i;
     ASSERT_TRUE(node.m_v == before.v[std::size_t(i)]) << what << " vertex " << i;
@@ -112,6 +120,7 @@ void expect_mirrors_mesh(const bullet::SkinnedSoftBody& body, const char* what) 
     EXPECT_LE(roots.size(), 1u) << what << ": a btSoftBody holds faces of several pieces";
     for (int i = 0; i < sb->m_links.size(); ++i) {
       const auto& l = sb->m_links[i];
+      if (l.m_material != sb->m_materials[0]) continue;  // a bending link (checked below)
       const std::int32_t a = vertex(l.m_n[0]), b = vertex(l.m_n[1]);
       const std::pair<std::int32_t, std::int32_t> e = std::minmax(a, b);
       ASSERT_TRUE(mesh_edges.count(e)) << what << ": link without a face";
@@ -130,7 +139,23 @@ void expect_mirrors_mesh(const bullet::SkinnedSoftBody& body, const char* what) 
       << what << ": " << only_mesh.size() << " faces only in the mesh, " << only_bullet.size()
       << " only in Bullet";
   EXPECT_EQ(links, mesh_edges.size()) << what;
-  for (std::size_t v = 0; v < seen.size(); ++v) ASSERT_EQ(seen[v], 1) << what << " vertex " << v;
+  EXPECT_EQ(std::int32_t(links), body.link_count()) << what;
+  // One node per vertex that has faces; a vertex without faces is detached (no node).
+  std::vector<int> has_face(seen.size(), 0);
+  for (const auto& f : m.faces)
+    for (const auto v : f) has_face[std::size_t(v)] = 1;
+  int detached = 0;
+  for (std::size_t v = 0; v < seen.size(); ++v) {
+    ASSERT_EQ(seen[v], has_face[v]) << what << " vertex " << v;
+    ASSERT_EQ(body.detached(std::int32_t(v)), !has_face[v]) << what << " vertex " << v;
+    detached += !has_face[v];
+  }
+  EXPECT_EQ(detached, body.detached_count()) << what;
+  // Bending links: exactly one across each edge of two faces when enabled, none otherwise.
+  const auto bending = conform::test::check_bending(body);
+  EXPECT_EQ(bending.wrong, 0) << what;
+  EXPECT_EQ(bending.links, body.bending_link_count()) << what;
+  EXPECT_EQ(bending.links, body.material().bending_stiffness > 0 ? bending.expected : 0) << what;
   EXPECT_EQ(body.piece_count(), mesh::label_pieces(m).count) << what;
 }
 
@@ -140,8 +165,9 @@ struct LiveArm {
   mesh::Arm arm = mesh::make_arm(1);
   bullet::SkinnedSoftBody* body = nullptr;
   skin::PoseTrack track;
-  LiveArm() {
-    body = &plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = 0.1});
+  explicit LiveArm(double bending = 0) {
+    body = &plugin.add_skinned_body(arm.mesh, arm.skeleton,
+                                    {.pretension = 0.1, .bending_stiffness = bending});
     track.set_key(0, skin::Pose::rest(arm.skeleton));
     track.set_key(2, conform::test::bent_arm_pose(arm.skeleton, 0.8, 1.2));
     body->set_keyframes(track);
@@ -204,24 +230,80 @@ TEST(PluginTopology, TearStepsEditInPlace) {
   EXPECT_EQ(body.piece_count(), 1);
 }
 
-TEST(PluginTopology, DrillKeepsTheHolesNodesAndMass) {
+// The inside of the holes (vertices left without faces) leaves Bullet: no node, link or face
+// of theirs remains, their mass and momentum stay in the books, and they lie inside the drill.
+TEST(PluginTopology, DrillDetachesTheHolesInsideKeepingMassAndMomentum) {
   LiveArm a;
   auto& body = *a.body;
   const Snapshot before = snapshot(body);
   // Through both walls of the upper arm, at its current (posed) place.
-  const Eigen::Vector3d c = body.position(1 + 40 * 32) * 0 + [&] {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    int n = 0;
-    for (std::int32_t v = 0; v < body.vertex_count(); ++v)
-      if (std::abs(a.arm.mesh.rest(2, v) - 0.15) < 0.01) mean += body.position(v), ++n;
-    return Eigen::Vector3d(mean / n);
-  }();
-  const auto result =
-      body.drill({c + Eigen::Vector3d(0, 0.2, 0), c - Eigen::Vector3d(0, 0.2, 0), 0.012});
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+    if (std::abs(a.arm.mesh.rest(2, v) - 0.15) < 0.01) c += body.position(v), ++n;
+  c /= n;
+  const mesh::DrillTool tool{c + Eigen::Vector3d(0, 0.2, 0), c - Eigen::Vector3d(0, 0.2, 0), 0.012};
+  const auto result = body.drill(tool);
   ASSERT_EQ(result.holes, 2) << result.message;
   expect_conserved(body, before, result.changes, "drill");
   expect_mirrors_mesh(body, "drill");
   EXPECT_EQ(body.piece_count(), 1);
+  EXPECT_GT(body.detached_count(), 0);
+  EXPECT_EQ(body.last_apply().detached_nodes, body.detached_count());
+  int nodes = 0;
+  for (btSoftBody* sb : body.pieces()) nodes += sb->m_nodes.size();
+  EXPECT_EQ(nodes + body.detached_count(), body.vertex_count());
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+    if (body.detached(v)) {
+      EXPECT_LT(mesh::axis_distance_squared(tool, body.position(v)),
+                tool.radius * tool.radius * (1 + 1e-9));
+      EXPECT_GT(body.mass(v), 0);  // the removed material's mass, kept in the books
+    }
+  const double mass = body.total_mass();
+  a.w.step(30);
+  EXPECT_EQ(body.total_mass(), mass);
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+    ASSERT_TRUE(body.position(v).allFinite() && body.velocity(v).allFinite());
+  expect_mirrors_mesh(body, "drill, 30 steps later");
+}
+
+// The same edits with bending links: survivors exact, Σm and Σm·v conserved, and the bending
+// links always exactly those across the edges of two faces (none across a cut, tear or hole).
+TEST(PluginTopology, EditsKeepBendingLinksAcrossEdgesOfTwoFacesOnly) {
+  LiveArm a(0.5);
+  auto& body = *a.body;
+  expect_mirrors_mesh(body, "bending, built");
+  EXPECT_GT(body.bending_link_count(), 0);
+  Snapshot before = snapshot(body);
+  body.begin_tear();
+  std::vector<mesh::TopologyChange> changes;
+  for (int i = 0; i <= 10; ++i) {
+    const double z = 0.08 + 0.005 * i;
+    const auto step = body.tear_advance({double(i), {0, 0, z}, {0.15, 0, z}});
+    changes.insert(changes.end(), step.changes.begin(), step.changes.end());
+  }
+  expect_conserved(body, before, changes, "bending tear");
+  expect_mirrors_mesh(body, "bending tear");
+  EXPECT_GT(body.last_apply().removed_bending, 0);
+  a.w.step(5);
+  before = snapshot(body);
+  const auto cut = body.cut(cga::Plane<double>::from_normal_point({0, 0, 1}, {0, 0, 0.42}));
+  ASSERT_EQ(cut.status, mesh::CutStatus::Cut);
+  expect_conserved(body, before, {cut.change}, "bending cut");
+  expect_mirrors_mesh(body, "bending cut");
+  EXPECT_EQ(body.piece_count(), 2);
+  a.w.step(5);
+  before = snapshot(body);
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (std::int32_t v = 0; v < a.arm.mesh.vertex_count(); ++v)
+    if (std::abs(a.arm.mesh.rest(2, v) - 0.25) < 0.01) c += body.position(v), ++n;
+  c /= n;
+  const auto drill =
+      body.drill({c + Eigen::Vector3d(0, 0.2, 0), c - Eigen::Vector3d(0, 0.2, 0), 0.012});
+  ASSERT_EQ(drill.holes, 2) << drill.message;
+  expect_conserved(body, before, drill.changes, "bending drill");
+  expect_mirrors_mesh(body, "bending drill");
   a.w.step(30);
   for (std::int32_t v = 0; v < body.vertex_count(); ++v)
     ASSERT_TRUE(body.position(v).allFinite() && body.velocity(v).allFinite());

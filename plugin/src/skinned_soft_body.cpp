@@ -3,6 +3,7 @@
 #include <BulletSoftBody/btSoftBody.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -41,9 +42,40 @@ struct SkinnedSoftBody::Piece {
   std::unique_ptr<btSoftBody> body;
   std::vector<std::int32_t> node_vertex;  // node index → mesh vertex
   std::vector<double> rest;               // link index → our rest length (Bullet resets its own)
-  std::vector<std::int32_t> face_id;      // Bullet face slot → mesh face
-  bool reapply = true;                    // we edited the body: Bullet resets rest lengths
+  std::vector<std::pair<std::int32_t, std::int32_t>> link_key;  // link → its key edge (min, max)
+  std::vector<std::uint8_t> link_bend;                          // link → 1 for a bending link
+  std::vector<std::int32_t> face_id;                            // Bullet face slot → mesh face
+  std::int32_t bending = 0;                                     // bending links in this body
+  bool reapply = true;  // rest lengths to write at the next update (set when built)
 };
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point& t) {
+  const auto now = Clock::now();
+  const double s = std::chrono::duration<double>(now - t).count();
+  t = now;
+  return s;
+}
+
+// Bullet's link constant c0 = (1/m_a + 1/m_b) / kLST (what its updateLinkConstants writes).
+void link_constant(btSoftBody::Link& l) {
+  l.m_c0 = (l.m_n[0]->m_im + l.m_n[1]->m_im) / l.m_material->m_kLST;
+}
+
+// Bullet's face m_ra: twice the triangle's area (its AreaOf).
+btScalar face_ra(const btSoftBody::Face& f) {
+  return btCross(f.m_n[1]->m_x - f.m_n[0]->m_x, f.m_n[2]->m_x - f.m_n[0]->m_x).length();
+}
+
+std::int32_t third_vertex(const mesh::Face& f, std::int32_t a, std::int32_t b) {
+  for (const auto v : f)
+    if (v != a && v != b) return v;
+  return -1;
+}
+
+}  // namespace
 
 SkinnedSoftBody::SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
                                  std::function<void(btSoftBody*)> remove,
@@ -73,6 +105,10 @@ SkinnedSoftBody::SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(b
   if (!(material_.pretension >= 0 && material_.pretension < 1))
     throw std::invalid_argument("SkinnedSoftBody: pretension must be in [0, 1)");
   if (!(material_.density > 0)) throw std::invalid_argument("SkinnedSoftBody: density must be > 0");
+  if (!(material_.link_stiffness > 0 && material_.link_stiffness <= 1))
+    throw std::invalid_argument("SkinnedSoftBody: link_stiffness must be in (0, 1]");
+  if (!(material_.bending_stiffness >= 0 && material_.bending_stiffness <= 1))
+    throw std::invalid_argument("SkinnedSoftBody: bending_stiffness must be in [0, 1]");
   adjacency_.build(mesh_);
   pose_ = skin::Pose::rest(skeleton_);
   global_.resize(static_cast<std::size_t>(skeleton_.joint_count()));
@@ -120,6 +156,8 @@ SkinnedSoftBody::Piece& SkinnedSoftBody::new_piece() {
   piece->body = std::make_unique<btSoftBody>(info_, 0, nullptr, nullptr);
   btSoftBody& body = *piece->body;
   body.m_materials[0]->m_kLST = btScalar(material_.link_stiffness);
+  if (material_.bending_stiffness > 0)
+    body.appendMaterial()->m_kLST = btScalar(material_.bending_stiffness);  // material 1
   body.m_cfg.kDP = btScalar(material_.damping);
   body.m_cfg.piterations = material_.position_iterations;
   body.getCollisionShape()->setMargin(btScalar(material_.margin));
@@ -138,6 +176,8 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
   vertex_faces_.assign(n, {});
   piece_of_.assign(n, -1);
   node_of_.assign(n, -1);
+  detached_slot_.assign(n, -1);
+  search_label_.assign(n, -1);
   for (std::size_t f = 0; f < faces_.size(); ++f) {
     for (const auto v : faces_[f])
       vertex_faces_[static_cast<std::size_t>(v)].push_back(std::int32_t(f));
@@ -153,13 +193,17 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
     new_piece();
     piece_index[static_cast<std::size_t>(p)] = std::int32_t(pieces_.size()) - 1;
   }
-  if (pieces_.empty()) new_piece();
   for (std::int32_t v = 0; v < m.vertex_count(); ++v) {
     const auto& vf = vertex_faces_[static_cast<std::size_t>(v)];
-    const std::int32_t p = vf.empty() ? 0
-                                      : piece_index[static_cast<std::size_t>(
-                                            labels.face_piece[static_cast<std::size_t>(vf[0])])];
-    add_node(p, v, m.current.col(v), Eigen::Vector3d::Zero());
+    if (vf.empty()) {  // no faces: not a node (its mass stays in the books)
+      detached_slot_[static_cast<std::size_t>(v)] = std::int32_t(detached_state_.size());
+      detached_state_.emplace_back(m.current.col(v), Eigen::Vector3d::Zero());
+      ++detached_count_;
+      continue;
+    }
+    add_node(
+        piece_index[static_cast<std::size_t>(labels.face_piece[static_cast<std::size_t>(vf[0])])],
+        v, m.current.col(v), Eigen::Vector3d::Zero());
   }
   for (std::int32_t f = 0; f < std::int32_t(faces_.size()); ++f) {
     const std::int32_t p =
@@ -173,17 +217,57 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
                  (1 - material_.pretension) * (m.current.col(a) - m.current.col(b)).norm());
     }
   }
+  if (material_.bending_stiffness > 0)
+    for (std::size_t f = 0; f < faces_.size(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const auto [a, b] = edge_key(faces_[f][k], faces_[f][(k + 1) % 3]);
+        refresh_bending(a, b);
+      }
+  for (std::int32_t v = 0; v < m.vertex_count(); ++v)
+    if (piece_of_[static_cast<std::size_t>(v)] >= 0) update_node_area(v);
+  relink_.clear();
+  bend_dirty_.clear();
   stats_ = {};
 }
 
+// --- Bullet edits. None sets Bullet's whole-body reset (m_bUpdateRtCst): the constants of
+// what changed are written here. ---
+
 void SkinnedSoftBody::set_node_mass(std::int32_t v) {
   const auto i = static_cast<std::size_t>(v);
+  if (piece_of_[i] < 0) return;
   btSoftBody::Node& node = body_of(v)->m_nodes[node_of_[i]];
   node.m_im = kinematic_[i] ? btScalar(0) : btScalar(1 / mass_[i]);
-  // Link constants (c0) depend on inverse masses: Bullet recomputes them, and resets rest
-  // lengths, at the next step.
-  body_of(v)->m_bUpdateRtCst = true;
-  pieces_[static_cast<std::size_t>(piece_of_[i])]->reapply = true;
+  update_link_constants(v);
+}
+
+void SkinnedSoftBody::update_link_constants(std::int32_t v) {
+  btSoftBody& body = *body_of(v);
+  const btSoftBody::Node* node = &body.m_nodes[node_of_[static_cast<std::size_t>(v)]];
+  auto touch = [&](std::int32_t li) {
+    if (li < 0 || li >= body.m_links.size()) return;
+    btSoftBody::Link& l = body.m_links[li];
+    if (l.m_n[0] == node || l.m_n[1] == node) link_constant(l);
+  };
+  for (const auto f : vertex_faces_[static_cast<std::size_t>(v)]) {
+    const auto& tri = faces_[static_cast<std::size_t>(f)];
+    for (int k = 0; k < 3; ++k) {
+      const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
+      touch(a == v || b == v ? edge_link_.find(a, b) : bend_link_.find(a, b));
+    }
+  }
+}
+
+void SkinnedSoftBody::update_node_area(std::int32_t v) {
+  const auto i = static_cast<std::size_t>(v);
+  if (piece_of_[i] < 0) return;
+  btSoftBody& body = *body_of(v);
+  btScalar sum = 0;
+  int count = 0;
+  for (const auto f : vertex_faces_[i])
+    if (face_piece_[static_cast<std::size_t>(f)] == piece_of_[i])
+      sum += btFabs(body.m_faces[face_slot_[static_cast<std::size_t>(f)]].m_ra), ++count;
+  body.m_nodes[node_of_[i]].m_area = count ? sum / btScalar(count) : btScalar(0);
 }
 
 void SkinnedSoftBody::add_node(std::int32_t p, std::int32_t v, const Eigen::Vector3d& x,
@@ -193,29 +277,91 @@ void SkinnedSoftBody::add_node(std::int32_t p, std::int32_t v, const Eigen::Vect
   body.appendNode(to_btv(x), 1);
   btSoftBody::Node& node = body.m_nodes[body.m_nodes.size() - 1];
   node.m_v = to_btv(vel);
-  piece_of_[static_cast<std::size_t>(v)] = p;
-  node_of_[static_cast<std::size_t>(v)] = body.m_nodes.size() - 1;
+  const auto i = static_cast<std::size_t>(v);
+  piece_of_[i] = p;
+  node_of_[i] = body.m_nodes.size() - 1;
   piece.node_vertex.push_back(v);
-  set_node_mass(v);
-  body.m_bUpdateRtCst = true;
-  piece.reapply = true;
+  node.m_im = kinematic_[i] ? btScalar(0) : btScalar(1 / mass_[i]);
+}
+
+void SkinnedSoftBody::remove_node(std::int32_t v) {
+  // Swap-with-last: the last node moves into the hole and the faces and links that point to
+  // it (found through its mesh faces) are re-pointed. v's own faces and links must be gone.
+  const auto iv = static_cast<std::size_t>(v);
+  const std::int32_t p = piece_of_[iv];
+  Piece& piece = *pieces_[static_cast<std::size_t>(p)];
+  btSoftBody& body = *piece.body;
+  const int i = node_of_[iv], last = body.m_nodes.size() - 1;
+  if (body.m_nodes[i].m_leaf) body.m_ndbvt.remove(body.m_nodes[i].m_leaf);
+  if (i != last) {
+    btSoftBody::Node* from = &body.m_nodes[last];
+    btSoftBody::Node* to = &body.m_nodes[i];
+    *to = *from;
+    if (to->m_leaf) to->m_leaf->data = to;
+    const std::int32_t w = piece.node_vertex[static_cast<std::size_t>(last)];
+    piece.node_vertex[static_cast<std::size_t>(i)] = w;
+    node_of_[static_cast<std::size_t>(w)] = i;
+    auto repoint_link = [&](std::int32_t li) {
+      if (li < 0 || li >= body.m_links.size()) return;
+      for (auto& n : body.m_links[li].m_n)
+        if (n == from) n = to;
+    };
+    for (const auto f : vertex_faces_[static_cast<std::size_t>(w)]) {
+      const auto fi = static_cast<std::size_t>(f);
+      if (face_piece_[fi] == p)
+        for (auto& n : body.m_faces[face_slot_[fi]].m_n)
+          if (n == from) n = to;
+      const auto& tri = faces_[fi];
+      for (int k = 0; k < 3; ++k) {
+        const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
+        repoint_link(a == w || b == w ? edge_link_.find(a, b) : bend_link_.find(a, b));
+      }
+    }
+  }
+  body.m_nodes.pop_back();
+  piece.node_vertex.pop_back();
+  piece_of_[iv] = -1;
+  node_of_[iv] = -1;
+}
+
+void SkinnedSoftBody::detach(std::int32_t v) {
+  const auto i = static_cast<std::size_t>(v);
+  const Eigen::Vector3d x = position(v), vel = velocity(v);
+  remove_node(v);
+  detached_slot_[i] = std::int32_t(detached_state_.size());
+  detached_state_.emplace_back(x, vel);
+  ++detached_count_;
+  ++stats_.detached_nodes;
 }
 
 void SkinnedSoftBody::add_face(std::int32_t p, std::int32_t f) {
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
+  btSoftBody& body = *piece.body;
   const auto& tri = faces_[static_cast<std::size_t>(f)];
-  piece.body->appendFace(node_of_[static_cast<std::size_t>(tri[0])],
-                         node_of_[static_cast<std::size_t>(tri[1])],
-                         node_of_[static_cast<std::size_t>(tri[2])]);
+  const bool reset = body.m_bUpdateRtCst;
+  body.appendFace(node_of_[static_cast<std::size_t>(tri[0])],
+                  node_of_[static_cast<std::size_t>(tri[1])],
+                  node_of_[static_cast<std::size_t>(tri[2])]);
+  body.m_bUpdateRtCst = reset;
+  btSoftBody::Face& face = body.m_faces[body.m_faces.size() - 1];
+  face.m_ra = face_ra(face);
   face_piece_[static_cast<std::size_t>(f)] = p;
-  face_slot_[static_cast<std::size_t>(f)] = piece.body->m_faces.size() - 1;
+  face_slot_[static_cast<std::size_t>(f)] = body.m_faces.size() - 1;
   piece.face_id.push_back(f);
-  piece.reapply = true;
 }
 
 void SkinnedSoftBody::remove_face_from_bullet(std::int32_t f) {
   const std::int32_t p = face_piece_[static_cast<std::size_t>(f)];
   if (p < 0) return;
+  if (material_.bending_stiffness > 0) {
+    // A bending link needs both faces of its edge.
+    const auto& tri = faces_[static_cast<std::size_t>(f)];
+    for (int k = 0; k < 3; ++k) {
+      const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
+      remove_bending(a, b);
+      bend_dirty_.emplace_back(a, b);
+    }
+  }
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
   const int slot = face_slot_[static_cast<std::size_t>(f)], last = body.m_faces.size() - 1;
@@ -230,92 +376,123 @@ void SkinnedSoftBody::remove_face_from_bullet(std::int32_t f) {
   piece.face_id.pop_back();
   face_piece_[static_cast<std::size_t>(f)] = -1;
   face_slot_[static_cast<std::size_t>(f)] = -1;
-  body.m_bUpdateRtCst = true;
-  piece.reapply = true;
   ++stats_.removed_faces;
 }
 
 void SkinnedSoftBody::add_link(std::int32_t p, std::int32_t u, std::int32_t v, double rest) {
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
+  const bool reset = body.m_bUpdateRtCst;
   body.appendLink(node_of_[static_cast<std::size_t>(u)], node_of_[static_cast<std::size_t>(v)],
                   nullptr, false);
+  body.m_bUpdateRtCst = reset;
   btSoftBody::Link& link = body.m_links[body.m_links.size() - 1];
   link.m_rl = btScalar(rest);
   link.m_c1 = btScalar(rest * rest);
+  link_constant(link);
   piece.rest.push_back(rest);
-  piece.reapply = true;
-  const auto [a, b] = edge_key(u, v);
-  edge_link_.insert(a, b, body.m_links.size() - 1, true);
+  const auto key = edge_key(u, v);
+  piece.link_key.push_back(key);
+  piece.link_bend.push_back(0);
+  edge_link_.insert(key.first, key.second, body.m_links.size() - 1, true);
   ++stats_.added_links;
+}
+
+void SkinnedSoftBody::add_bending(std::int32_t p, std::int32_t a, std::int32_t b, std::int32_t c,
+                                  std::int32_t d, double rest) {
+  Piece& piece = *pieces_[static_cast<std::size_t>(p)];
+  btSoftBody& body = *piece.body;
+  const bool reset = body.m_bUpdateRtCst;
+  body.appendLink(node_of_[static_cast<std::size_t>(c)], node_of_[static_cast<std::size_t>(d)],
+                  body.m_materials[1], false);
+  body.m_bUpdateRtCst = reset;
+  btSoftBody::Link& link = body.m_links[body.m_links.size() - 1];
+  link.m_rl = btScalar(rest);
+  link.m_c1 = btScalar(rest * rest);
+  link_constant(link);
+  piece.rest.push_back(rest);
+  piece.link_key.emplace_back(a, b);
+  piece.link_bend.push_back(1);
+  ++piece.bending;
+  bend_link_.insert(a, b, body.m_links.size() - 1, true);
+  ++stats_.added_bending;
+}
+
+void SkinnedSoftBody::remove_bending(std::int32_t a, std::int32_t b) {
+  const std::int32_t li = bend_link_.find(a, b);
+  if (li < 0) return;
+  const std::int32_t p = piece_of_[static_cast<std::size_t>(a)];
+  Piece& piece = *pieces_[static_cast<std::size_t>(p)];
+  btSoftBody& body = *piece.body;
+  const btSoftBody::Link& l = body.m_links[li];
+  const std::int32_t c = piece.node_vertex[static_cast<std::size_t>(l.m_n[0] - &body.m_nodes[0])],
+                     d = piece.node_vertex[static_cast<std::size_t>(l.m_n[1] - &body.m_nodes[0])];
+  relink_.emplace_back(a, b, std::min(c, d), std::max(c, d),
+                       piece.rest[static_cast<std::size_t>(li)]);
+  remove_link(p, li);
+  --stats_.removed_links;
+  ++stats_.removed_bending;
 }
 
 void SkinnedSoftBody::remove_link(std::int32_t p, std::int32_t li) {
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
   const int last = body.m_links.size() - 1;
+  const auto l = static_cast<std::size_t>(li), e = static_cast<std::size_t>(last);
   {
-    const btSoftBody::Link& l = body.m_links[li];
-    const auto [a, b] =
-        edge_key(piece.node_vertex[static_cast<std::size_t>(l.m_n[0] - &body.m_nodes[0])],
-                 piece.node_vertex[static_cast<std::size_t>(l.m_n[1] - &body.m_nodes[0])]);
-    edge_link_.erase(a, b, li);
+    const auto [a, b] = piece.link_key[l];
+    if (piece.link_bend[l])
+      bend_link_.erase(a, b, li), --piece.bending;
+    else
+      edge_link_.erase(a, b, li);
   }
   if (li != last) {
     body.m_links[li] = body.m_links[last];
-    piece.rest[static_cast<std::size_t>(li)] = piece.rest[static_cast<std::size_t>(last)];
-    const btSoftBody::Link& l = body.m_links[li];
-    const auto [a, b] =
-        edge_key(piece.node_vertex[static_cast<std::size_t>(l.m_n[0] - &body.m_nodes[0])],
-                 piece.node_vertex[static_cast<std::size_t>(l.m_n[1] - &body.m_nodes[0])]);
-    edge_link_.insert(a, b, li, true);
+    piece.rest[l] = piece.rest[e];
+    piece.link_key[l] = piece.link_key[e];
+    piece.link_bend[l] = piece.link_bend[e];
+    const auto [a, b] = piece.link_key[l];
+    (piece.link_bend[l] ? bend_link_ : edge_link_).insert(a, b, li, true);
   }
   body.m_links.pop_back();
   piece.rest.pop_back();
-  body.m_bUpdateRtCst = true;
-  piece.reapply = true;
+  piece.link_key.pop_back();
+  piece.link_bend.pop_back();
   ++stats_.removed_links;
 }
 
-void SkinnedSoftBody::remove_nodes(std::int32_t p, const std::vector<std::int32_t>& vertices) {
-  // Compaction with one re-pointing pass (only on splits): links and faces touching these
-  // nodes must already be gone.
-  Piece& piece = *pieces_[static_cast<std::size_t>(p)];
-  btSoftBody& body = *piece.body;
-  const int count = body.m_nodes.size();
-  std::vector<int> new_index(static_cast<std::size_t>(count), 0);
-  for (const auto v : vertices)
-    new_index[static_cast<std::size_t>(node_of_[static_cast<std::size_t>(v)])] = -1;
-  int j = 0;
-  for (int i = 0; i < count; ++i) {
-    if (new_index[static_cast<std::size_t>(i)] < 0) {
-      if (body.m_nodes[i].m_leaf) body.m_ndbvt.remove(body.m_nodes[i].m_leaf);
-      continue;
-    }
-    if (j != i) {
-      body.m_nodes[j] = body.m_nodes[i];
-      piece.node_vertex[static_cast<std::size_t>(j)] =
-          piece.node_vertex[static_cast<std::size_t>(i)];
-    }
-    if (body.m_nodes[j].m_leaf) body.m_nodes[j].m_leaf->data = &body.m_nodes[j];
-    node_of_[static_cast<std::size_t>(piece.node_vertex[static_cast<std::size_t>(j)])] = j;
-    new_index[static_cast<std::size_t>(i)] = j++;
+void SkinnedSoftBody::refresh_bending(std::int32_t a, std::int32_t b) {
+  // A bending link across (a, b) iff exactly two faces use the edge, both in the same body;
+  // it joins their third vertices. A link of the same vertices removed earlier in this change
+  // (a face moved into another body) keeps its rest length.
+  if (bend_link_.find(a, b) >= 0) return;
+  std::int32_t found[2] = {-1, -1};
+  int count = 0;
+  for (const auto f : vertex_faces_[static_cast<std::size_t>(a)]) {
+    const auto& tri = faces_[static_cast<std::size_t>(f)];
+    if (tri[0] != b && tri[1] != b && tri[2] != b) continue;
+    if (count < 2) found[count] = f;
+    ++count;
   }
-  btSoftBody::Node* base = count ? &body.m_nodes[0] : nullptr;
-  auto repoint = [&](btSoftBody::Node*& n) {
-    n = base + new_index[static_cast<std::size_t>(n - base)];
-  };
-  for (int i = 0; i < body.m_links.size(); ++i)
-    repoint(body.m_links[i].m_n[0]), repoint(body.m_links[i].m_n[1]);
-  for (int i = 0; i < body.m_faces.size(); ++i)
-    for (auto& n : body.m_faces[i].m_n) repoint(n);
-  while (body.m_nodes.size() > j) body.m_nodes.pop_back();  // resize() would build a Node
-  piece.node_vertex.resize(static_cast<std::size_t>(j));
-  body.m_bUpdateRtCst = true;
-  piece.reapply = true;
+  if (count != 2) return;
+  const std::int32_t p = face_piece_[static_cast<std::size_t>(found[0])];
+  if (p < 0 || face_piece_[static_cast<std::size_t>(found[1])] != p) return;
+  const std::int32_t c = third_vertex(faces_[static_cast<std::size_t>(found[0])], a, b),
+                     d = third_vertex(faces_[static_cast<std::size_t>(found[1])], a, b);
+  if (c < 0 || d < 0 || c == d) return;
+  double rest = -1;
+  const std::tuple key{a, b, std::min(c, d), std::max(c, d), -1.0};
+  const auto it = std::lower_bound(relink_.begin(), relink_.end(), key);  // relink_ is sorted
+  if (it != relink_.end() && std::get<0>(*it) == a && std::get<1>(*it) == b &&
+      std::get<2>(*it) == std::get<2>(key) && std::get<3>(*it) == std::get<3>(key))
+    rest = std::get<4>(*it);
+  if (rest < 0) rest = (1 - material_.pretension) * (position(c) - position(d)).norm();
+  add_bending(p, a, b, c, d, rest);
 }
 
 void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
+  auto clock = Clock::now();
+  auto& sec = stats_.seconds;
   const std::int32_t v0 = change.base_vertex_count;
   if (v0 != std::int32_t(piece_of_.size()) || change.base_face_count != std::int32_t(faces_.size()))
     throw std::logic_error("SkinnedSoftBody: change does not match the mirrored mesh");
@@ -323,6 +500,9 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   const auto total = static_cast<std::size_t>(v0 + nnew);
   if (mesh_.vertex_count() < v0 + nnew)
     throw std::logic_error("SkinnedSoftBody: mesh lacks the change's new vertices");
+  const bool bending = material_.bending_stiffness > 0;
+  relink_.clear();
+  bend_dirty_.clear();
 
   // 1. New vertices: x and v interpolated from the parents; mass taken from the parents in
   // proportion to the same coefficients, so Σm and Σm·v are unchanged exactly.
@@ -330,6 +510,8 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       nv(static_cast<std::size_t>(nnew));
   piece_of_.resize(total, -1);
   node_of_.resize(total, -1);
+  detached_slot_.resize(total, -1);
+  search_label_.resize(total, -1);
   mass_.resize(total, 0);
   pinned_.resize(total, 0);
   kinematic_.resize(total, 0);
@@ -371,9 +553,11 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     pinned_[static_cast<std::size_t>(id)] = pinned;
     kinematic_[static_cast<std::size_t>(id)] = pinned || is_kinematic_by_weight(id);
   }
+  sec.vertices += seconds_since(clock);
 
-  // 2. Removed faces leave Bullet; edges no face uses any more lose their link.
-  std::vector<std::int32_t> seeds;  // old vertices around the change (their pieces may split)
+  // 2. Removed faces leave Bullet; edges no face uses any more lose their link (kept aside:
+  // an edge that comes back in the same change keeps its rest length).
+  std::vector<std::int32_t> seeds;  // vertices around the change (their pieces may split)
   std::vector<std::pair<std::int32_t, std::int32_t>> dropped;
   for (const auto f : change.removed_faces) {
     const auto tri = faces_[static_cast<std::size_t>(f)];
@@ -393,7 +577,10 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   }
   for (const auto& [a, b] : dropped) {
     const std::int32_t li = edge_link_.find(a, b);
-    if (li >= 0) remove_link(piece_of_[static_cast<std::size_t>(a)], li);
+    if (li < 0) continue;
+    const std::int32_t p = piece_of_[static_cast<std::size_t>(a)];
+    relink_.emplace_back(a, b, a, b, pieces_[static_cast<std::size_t>(p)]->rest[std::size_t(li)]);
+    remove_link(p, li);
   }
 
   // 3. The face slots, exactly as mesh::apply does them (topology_change.hpp).
@@ -435,7 +622,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     const auto& tri = faces_[static_cast<std::size_t>(f)];
     for (int k = 0; k < 3; ++k) {
       vertex_faces_[static_cast<std::size_t>(tri[k])].push_back(f);
-      if (tri[k] < v0) seeds.push_back(tri[k]);
+      seeds.push_back(tri[k]);
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
       const std::int32_t c = edge_faces_.find(a, b);
       edge_faces_.insert(a, b, c < 0 ? 1 : c + 1, true);
@@ -443,44 +630,108 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   }
   stats_.added_faces += std::int32_t(pending.size());
   stats_.new_nodes += nnew;
+  for (std::int32_t i = 0; i < nnew; ++i) seeds.push_back(v0 + i);
+  std::sort(seeds.begin(), seeds.end());
+  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  sec.faces += seconds_since(clock);
 
-  // 4. Connected components around the change (a BFS over the affected pieces).
-  std::vector<std::int32_t> affected;
-  for (const auto v : seeds) affected.push_back(piece_of_[static_cast<std::size_t>(v)]);
-  for (const auto& nvx : change.new_vertices)
-    for (const auto p : nvx.parents)
-      if (p >= 0 && p < v0) affected.push_back(piece_of_[static_cast<std::size_t>(p)]);
-  std::sort(affected.begin(), affected.end());
-  affected.erase(std::unique(affected.begin(), affected.end()), affected.end());
-  std::vector<std::int32_t> label(total, -1);
-  std::vector<std::vector<std::int32_t>> components;
-  std::vector<std::int32_t> queue;
-  auto explore = [&](std::int32_t start) {
-    if (label[static_cast<std::size_t>(start)] >= 0 ||
-        vertex_faces_[static_cast<std::size_t>(start)].empty())
-      return;
-    const std::int32_t c = std::int32_t(components.size());
-    components.emplace_back();
-    queue.assign(1, start);
-    label[static_cast<std::size_t>(start)] = c;
-    while (!queue.empty()) {
-      const std::int32_t u = queue.back();
-      queue.pop_back();
-      components.back().push_back(u);
-      for (const auto f : vertex_faces_[static_cast<std::size_t>(u)])
-        for (const auto w : faces_[static_cast<std::size_t>(f)])
-          if (label[static_cast<std::size_t>(w)] < 0) {
-            label[static_cast<std::size_t>(w)] = c;
-            queue.push_back(w);
-          }
-    }
+  // 4. Connected pieces around the change. A piece can only split where faces changed, so one
+  // search starts at every changed vertex; searches that meet merge into a group, and they
+  // advance in turn, one vertex each, until at most one group is still growing. The exhausted
+  // groups are complete pieces (no larger than the growing one, up to the turn order); the
+  // growing one is the rest of its body, which keeps its btSoftBody unexplored. Only if that
+  // group reaches vertices of two bodies (a merge) or of none is it explored to the end.
+  struct Search {
+    std::vector<std::int32_t> queue;  // the vertices it labelled, in order
+    std::size_t head = 0;
+    std::int32_t root;
   };
-  for (const auto p : affected)
-    for (const auto v : pieces_[static_cast<std::size_t>(p)]->node_vertex) explore(v);
-  for (std::int32_t i = 0; i < nnew; ++i) explore(v0 + i);
+  std::vector<Search> searches;
+  auto root_of = [&](std::int32_t s) {
+    while (searches[static_cast<std::size_t>(s)].root != s) {
+      auto& r = searches[static_cast<std::size_t>(s)].root;
+      r = searches[static_cast<std::size_t>(r)].root;
+      s = r;
+    }
+    return s;
+  };
+  for (const auto v : seeds) {
+    const auto i = static_cast<std::size_t>(v);
+    if (vertex_faces_[i].empty() || search_label_[i] >= 0) continue;
+    search_label_[i] = std::int32_t(searches.size());
+    searches.push_back({{v}, 0, std::int32_t(searches.size())});
+  }
+  std::vector<std::int32_t> active, roots;
+  for (std::size_t s = 0; s < searches.size(); ++s) active.push_back(std::int32_t(s));
+  std::int32_t open_root = -1, open_piece = -1;
+  bool to_the_end = false;
+  while (!active.empty()) {
+    roots.clear();
+    for (const auto s : active) roots.push_back(root_of(s));
+    std::sort(roots.begin(), roots.end());
+    roots.erase(std::unique(roots.begin(), roots.end()), roots.end());
+    if (roots.size() == 1 && !to_the_end) {
+      // Which bodies does the growing group touch so far?
+      std::int32_t piece = -1;
+      bool several = false;
+      for (std::size_t s = 0; s < searches.size() && !several; ++s) {
+        if (root_of(std::int32_t(s)) != roots[0]) continue;
+        for (const auto v : searches[s].queue) {
+          const std::int32_t p = piece_of_[static_cast<std::size_t>(v)];
+          if (p < 0) continue;
+          if (piece >= 0 && p != piece) several = true;
+          piece = p;
+        }
+      }
+      if (piece >= 0 && !several) {
+        open_root = roots[0];
+        open_piece = piece;
+        break;
+      }
+      to_the_end = true;
+    }
+    std::size_t kept = 0;
+    for (const auto s : active) {
+      auto& search = searches[static_cast<std::size_t>(s)];
+      if (search.head < search.queue.size()) {
+        const std::int32_t u = search.queue[search.head++];
+        for (const auto f : vertex_faces_[static_cast<std::size_t>(u)])
+          for (const auto w : faces_[static_cast<std::size_t>(f)]) {
+            std::int32_t& label = search_label_[static_cast<std::size_t>(w)];
+            if (label < 0) {
+              label = s;
+              searches[static_cast<std::size_t>(s)].queue.push_back(w);
+            } else {
+              const std::int32_t a = root_of(label), b = root_of(s);
+              if (a != b) searches[static_cast<std::size_t>(std::max(a, b))].root = std::min(a, b);
+            }
+          }
+      }
+      if (searches[static_cast<std::size_t>(s)].head <
+          searches[static_cast<std::size_t>(s)].queue.size())
+        active[kept++] = s;
+    }
+    active.resize(kept);
+  }
+  // Complete groups, as lists of vertices.
+  std::vector<std::int32_t> group_of_root(searches.size(), -1);
+  std::vector<std::vector<std::int32_t>> components;
+  for (std::size_t s = 0; s < searches.size(); ++s) {
+    stats_.searched_vertices += std::int32_t(searches[s].queue.size());
+    const std::int32_t r = root_of(std::int32_t(s));
+    if (r == open_root) continue;
+    auto& g = group_of_root[static_cast<std::size_t>(r)];
+    if (g < 0) {
+      g = std::int32_t(components.size());
+      components.emplace_back();
+    }
+    auto& list = components[static_cast<std::size_t>(g)];
+    list.insert(list.end(), searches[s].queue.begin(), searches[s].queue.end());
+  }
 
-  // Each old piece keeps the component holding most of its nodes; a component wanted by two
-  // pieces (a merge) goes to the one with more nodes there; the rest become new pieces.
+  // The growing group keeps its body. Each other body goes to the complete group holding most
+  // of its nodes; a group wanted by two bodies (a merge) goes to the one with more nodes there;
+  // the remaining groups become new bodies.
   std::vector<std::int32_t> owner(components.size(), -1), owner_count(components.size(), 0);
   {
     std::vector<std::pair<std::int32_t, std::int32_t>> best;  // per piece: (component, count)
@@ -489,7 +740,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       std::vector<std::pair<std::int32_t, std::int32_t>> counts;
       for (const auto v : components[c]) {
         const std::int32_t p = piece_of_[static_cast<std::size_t>(v)];
-        if (p < 0) continue;
+        if (p < 0 || p == open_piece) continue;
         auto it = std::find_if(counts.begin(), counts.end(), [&](auto& e) { return e.first == p; });
         if (it == counts.end())
           counts.emplace_back(p, 1);
@@ -515,10 +766,10 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       }
     }
   }
+  sec.pieces += seconds_since(clock);
 
   // 5. Moves (splits and merges): the moving nodes' faces and links leave their old body, the
   // nodes follow with x, v and mass exactly, and the faces and links are rebuilt in the new one.
-  std::vector<std::tuple<std::int32_t, std::int32_t, double>> relink;
   for (std::size_t c = 0; c < components.size(); ++c) {
     std::vector<std::int32_t> moving;
     for (const auto v : components[c]) {
@@ -530,7 +781,6 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       new_piece();
       owner[c] = std::int32_t(pieces_.size()) - 1;
     }
-    std::vector<std::pair<std::int32_t, std::vector<std::int32_t>>> by_source;
     std::vector<std::pair<btVector3, btVector3>> state;
     for (const auto v : moving) {
       for (const auto f : vertex_faces_[static_cast<std::size_t>(v)]) {
@@ -544,23 +794,17 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
           const std::int32_t li = edge_link_.find(a, b);
           if (li < 0) continue;
           const std::int32_t lp = piece_of_[static_cast<std::size_t>(a)];
-          relink.emplace_back(
-              a, b, pieces_[static_cast<std::size_t>(lp)]->rest[static_cast<std::size_t>(li)]);
+          relink_.emplace_back(
+              a, b, a, b,
+              pieces_[static_cast<std::size_t>(lp)]->rest[static_cast<std::size_t>(li)]);
           remove_link(lp, li);
           --stats_.removed_links;
         }
       }
-      const std::int32_t p = piece_of_[static_cast<std::size_t>(v)];
-      auto it =
-          std::find_if(by_source.begin(), by_source.end(), [&](auto& e) { return e.first == p; });
-      if (it == by_source.end())
-        by_source.emplace_back(p, std::vector<std::int32_t>{v});
-      else
-        it->second.push_back(v);
       const btSoftBody::Node& node = body_of(v)->m_nodes[node_of_[static_cast<std::size_t>(v)]];
       state.emplace_back(node.m_x, node.m_v);
     }
-    for (const auto& [p, list] : by_source) remove_nodes(p, list);
+    for (const auto v : moving) remove_node(v);
     for (std::size_t i = 0; i < moving.size(); ++i) {
       add_node(owner[c], moving[i], to_eigen(state[i].first), to_eigen(state[i].second));
       // Bit-exact copy (the double round trip is exact, but say so in code).
@@ -571,38 +815,46 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     }
     stats_.moved_nodes += std::int32_t(moving.size());
   }
+  sec.split += seconds_since(clock);
 
-  // 6. New nodes join their component's piece (a new vertex without faces joins its parent's).
+  // 6. Old vertices left without faces leave Bullet; new nodes join their group's body (a new
+  // vertex without faces is detached at once).
+  for (const auto v : seeds)
+    if (v < v0 && piece_of_[static_cast<std::size_t>(v)] >= 0 &&
+        vertex_faces_[static_cast<std::size_t>(v)].empty())
+      detach(v);
   for (std::int32_t i = 0; i < nnew; ++i) {
     const std::int32_t id = v0 + i;
-    const std::int32_t c = label[static_cast<std::size_t>(id)];
-    std::int32_t p = -1;
-    if (c >= 0) {
-      if (owner[static_cast<std::size_t>(c)] < 0) {
+    const std::int32_t label = search_label_[static_cast<std::size_t>(id)];
+    if (label < 0) {
+      detached_slot_[static_cast<std::size_t>(id)] = std::int32_t(detached_state_.size());
+      detached_state_.emplace_back(nx[static_cast<std::size_t>(i)],
+                                   nv[static_cast<std::size_t>(i)]);
+      ++detached_count_;
+      ++stats_.detached_nodes;
+      continue;
+    }
+    const std::int32_t r = root_of(label);
+    std::int32_t p = open_piece;
+    if (r != open_root) {
+      auto& o = owner[static_cast<std::size_t>(group_of_root[static_cast<std::size_t>(r)])];
+      if (o < 0) {
         new_piece();
-        owner[static_cast<std::size_t>(c)] = std::int32_t(pieces_.size()) - 1;
+        o = std::int32_t(pieces_.size()) - 1;
       }
-      p = owner[static_cast<std::size_t>(c)];
-    } else {
-      for (const auto parent : change.new_vertices[static_cast<std::size_t>(i)].parents)
-        if (parent >= 0 && piece_of_[static_cast<std::size_t>(parent)] >= 0) {
-          p = piece_of_[static_cast<std::size_t>(parent)];
-          break;
-        }
-      if (p < 0) {
-        new_piece();
-        p = std::int32_t(pieces_.size()) - 1;
-      }
+      p = o;
     }
     add_node(p, id, nx[static_cast<std::size_t>(i)], nv[static_cast<std::size_t>(i)]);
   }
+  for (const auto& s : searches)
+    for (const auto v : s.queue) search_label_[static_cast<std::size_t>(v)] = -1;
   for (const auto v : touched) set_node_mass(v);
 
   // 7. Faces and links into Bullet; a moved link keeps its rest length, a new one gets
-  // (1 − s) × its current length.
+  // (1 − s) × its current length. Then bending links of the edges whose faces changed.
   std::sort(pending.begin(), pending.end());
   pending.erase(std::unique(pending.begin(), pending.end()), pending.end());
-  std::sort(relink.begin(), relink.end());
+  std::sort(relink_.begin(), relink_.end());
   for (const auto f : pending) {
     if (face_piece_[static_cast<std::size_t>(f)] >= 0) continue;
     const auto tri = faces_[static_cast<std::size_t>(f)];
@@ -610,16 +862,27 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     add_face(p, f);
     for (int k = 0; k < 3; ++k) {
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
+      if (bending) bend_dirty_.emplace_back(a, b);
       if (edge_link_.find(a, b) >= 0) continue;
-      auto it = std::lower_bound(relink.begin(), relink.end(), std::tuple{a, b, -1.0});
-      if (it != relink.end() && std::get<0>(*it) == a && std::get<1>(*it) == b) {
-        add_link(p, a, b, std::get<2>(*it));
+      const std::tuple key{a, b, a, b, -1.0};
+      auto it = std::lower_bound(relink_.begin(), relink_.end(), key);
+      if (it != relink_.end() && std::get<0>(*it) == a && std::get<1>(*it) == b &&
+          std::get<2>(*it) == a && std::get<3>(*it) == b) {
+        add_link(p, a, b, std::get<4>(*it));
         --stats_.added_links;
       } else {
         add_link(p, a, b, (1 - material_.pretension) * (position(a) - position(b)).norm());
       }
     }
   }
+  if (bending) {
+    std::sort(bend_dirty_.begin(), bend_dirty_.end());
+    bend_dirty_.erase(std::unique(bend_dirty_.begin(), bend_dirty_.end()), bend_dirty_.end());
+    for (const auto& [a, b] : bend_dirty_) refresh_bending(a, b);
+  }
+  for (const auto v : seeds) update_node_area(v);
+  for (const auto f : pending)
+    for (const auto v : faces_[static_cast<std::size_t>(f)]) update_node_area(v);
 
   // Pieces left without nodes leave the world.
   for (auto& piece : pieces_)
@@ -627,11 +890,16 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       remove_(piece->body.get());
       piece.reset();
     }
+  relink_.clear();
+  bend_dirty_.clear();
+  sec.insert += seconds_since(clock);
 }
 
 void SkinnedSoftBody::apply(const mesh::TopologyChange& change) {
   stats_ = {};
+  auto clock = Clock::now();
   mesh::apply(mesh_, change, &adjacency_);
+  stats_.seconds.mesh += seconds_since(clock);
   mirror(change);
 }
 
@@ -641,18 +909,26 @@ void SkinnedSoftBody::sync_mesh() {
 
 mesh::CutResult SkinnedSoftBody::cut(const cga::Plane<double>& plane,
                                      const mesh::CutOptions& options) {
-  sync_mesh();
-  mesh::CutResult result = mesh::compute_cut(mesh_, plane, options);
   stats_ = {};
+  auto clock = Clock::now();
+  sync_mesh();
+  const double sync = seconds_since(clock);
+  mesh::CutResult result = mesh::compute_cut(mesh_, plane, options);
+  const double compute = seconds_since(clock);
   if (result.status == mesh::CutStatus::Cut) apply(result.change);
+  stats_.seconds.sync = sync;
+  stats_.seconds.mesh += compute;
   return result;
 }
 
 mesh::DrillResult SkinnedSoftBody::drill(const mesh::DrillTool& tool,
                                          const mesh::DrillOptions& options) {
-  sync_mesh();
-  mesh::DrillResult result = mesh::drill(mesh_, adjacency_, tool, options);
   stats_ = {};
+  auto clock = Clock::now();
+  sync_mesh();
+  stats_.seconds.sync = seconds_since(clock);
+  mesh::DrillResult result = mesh::drill(mesh_, adjacency_, tool, options);
+  stats_.seconds.mesh = seconds_since(clock);
   for (const auto& change : result.changes) mirror(change);
   return result;
 }
@@ -663,9 +939,12 @@ void SkinnedSoftBody::begin_tear(const mesh::TearOptions& options) {
 
 mesh::TearStep SkinnedSoftBody::tear_advance(const mesh::ScalpelSample& sample) {
   if (!tear_) begin_tear();
-  sync_mesh();
-  mesh::TearStep step = tear_->advance(sample);
   stats_ = {};
+  auto clock = Clock::now();
+  sync_mesh();
+  stats_.seconds.sync = seconds_since(clock);
+  mesh::TearStep step = tear_->advance(sample);
+  stats_.seconds.mesh = seconds_since(clock);
   for (const auto& change : step.changes) mirror(change);
   return step;
 }
@@ -704,9 +983,7 @@ void SkinnedSoftBody::set_pinned(std::span<const std::int32_t> vertices) {
     const bool k = pinned_[i] || is_kinematic_by_weight(v);
     if (k == bool(kinematic_[i])) continue;
     kinematic_[i] = k;
-    set_node_mass(v);
-    body_of(v)->m_bUpdateRtCst = true;  // link constants depend on inverse masses
-    pieces_[static_cast<std::size_t>(piece_of_[i])]->reapply = true;
+    set_node_mass(v);  // and the constants of its links
   }
 }
 
@@ -810,7 +1087,8 @@ std::vector<btSoftBody*> SkinnedSoftBody::pieces() const {
 }
 
 btSoftBody* SkinnedSoftBody::body_of(std::int32_t v) const {
-  return pieces_[static_cast<std::size_t>(piece_of_[static_cast<std::size_t>(v)])]->body.get();
+  const std::int32_t p = piece_of_[static_cast<std::size_t>(v)];
+  return p < 0 ? nullptr : pieces_[static_cast<std::size_t>(p)]->body.get();
 }
 
 std::int32_t SkinnedSoftBody::vertex_of(const btSoftBody* body, int node) const {
@@ -823,11 +1101,15 @@ std::int32_t SkinnedSoftBody::vertex_of(const btSoftBody* body, int node) const 
 }
 
 Eigen::Vector3d SkinnedSoftBody::position(std::int32_t v) const {
-  return to_eigen(body_of(v)->m_nodes[node_of_[static_cast<std::size_t>(v)]].m_x);
+  const auto i = static_cast<std::size_t>(v);
+  if (piece_of_[i] < 0) return detached_state_[static_cast<std::size_t>(detached_slot_[i])].first;
+  return to_eigen(body_of(v)->m_nodes[node_of_[i]].m_x);
 }
 
 Eigen::Vector3d SkinnedSoftBody::velocity(std::int32_t v) const {
-  return to_eigen(body_of(v)->m_nodes[node_of_[static_cast<std::size_t>(v)]].m_v);
+  const auto i = static_cast<std::size_t>(v);
+  if (piece_of_[i] < 0) return detached_state_[static_cast<std::size_t>(detached_slot_[i])].second;
+  return to_eigen(body_of(v)->m_nodes[node_of_[i]].m_v);
 }
 
 Eigen::Vector3d SkinnedSoftBody::target(std::int32_t v) const {
@@ -858,15 +1140,30 @@ double SkinnedSoftBody::momentum_scale() const {
 double SkinnedSoftBody::rest_length(std::int32_t u, std::int32_t v) const {
   const auto [a, b] = edge_key(u, v);
   const std::int32_t li = edge_link_.find(a, b);
-  if (li < 0) return -1;
-  return pieces_[static_cast<std::size_t>(piece_of_[static_cast<std::size_t>(a)])]
-      ->rest[static_cast<std::size_t>(li)];
+  const std::int32_t p = piece_of_[static_cast<std::size_t>(a)];
+  if (li < 0 || p < 0) return -1;
+  return pieces_[static_cast<std::size_t>(p)]->rest[static_cast<std::size_t>(li)];
+}
+
+double SkinnedSoftBody::bending_rest_length(std::int32_t u, std::int32_t v) const {
+  const auto [a, b] = edge_key(u, v);
+  const std::int32_t li = bend_link_.find(a, b);
+  const std::int32_t p = piece_of_[static_cast<std::size_t>(a)];
+  if (li < 0 || p < 0) return -1;
+  return pieces_[static_cast<std::size_t>(p)]->rest[static_cast<std::size_t>(li)];
 }
 
 std::int32_t SkinnedSoftBody::link_count() const {
   std::int32_t n = 0;
   for (const auto& p : pieces_)
-    if (p) n += p->body->m_links.size();
+    if (p) n += p->body->m_links.size() - p->bending;
+  return n;
+}
+
+std::int32_t SkinnedSoftBody::bending_link_count() const {
+  std::int32_t n = 0;
+  for (const auto& p : pieces_)
+    if (p) n += p->bending;
   return n;
 }
 

@@ -1,10 +1,19 @@
 // A Bullet soft body whose skinning path is CGA motor skinning (eq 17), and whose topology
 // changes at run time (cut, tear, drill) while it simulates.
 //
-// Mesh ↔ Bullet: nodes = vertices, links = edges of faces, faces = triangles. Every connected
-// piece of the mesh is its own btSoftBody (Bullet's face tree never returns on a body whose
-// faces are not edge-connected); a vertex left without faces (e.g. inside a drilled hole) stays
-// as an isolated node of its piece, so mass is never lost.
+// Mesh ↔ Bullet: nodes = vertices, links = edges of faces (the body's material 0), faces =
+// triangles, and optional bending links (material 1) joining the two vertices opposite each
+// edge shared by two faces. Every connected piece of the mesh is its own btSoftBody (Bullet's
+// face tree never returns on a body whose faces are not edge-connected). A vertex left without
+// faces (the inside of a drilled hole) is detached: it leaves Bullet (no node, link, collision
+// or solver work), and its mass and momentum at that moment stay in the books (total_mass(),
+// momentum()) as the removed material's, so that edits conserve both exactly.
+//
+// Edits cost time proportional to the change: nodes, links and faces are removed by
+// swap-with-last with local re-pointing; link constants, rest lengths and face areas of what
+// changed are written here, so Bullet's whole-body reset (m_bUpdateRtCst) is never triggered;
+// a split is found by searches from the changed vertices that stop once all but one of them
+// are exhausted, and only the exhausted (smaller) side moves into a new btSoftBody.
 //
 // Each substep (in the plugin's action, after Bullet's motion prediction and before its
 // constraint solve) the pose source gives a skeleton pose, CGA skinning gives every vertex its
@@ -21,6 +30,8 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "conform/cga/plane.hpp"
@@ -63,6 +74,11 @@ struct Material {
   double kinematic_weight = 0.999;
   /// Bullet's position iterations per substep.
   int position_iterations = 4;
+  /// Bending links: Bullet's linear stiffness kLST of a link joining the two vertices opposite
+  /// each edge shared by exactly two faces, dimensionless in [0, 1]. 0 (default) makes none.
+  /// Rest lengths follow the pretension rule of the edge links. They are kept through
+  /// topology changes: a link across an edge that is cut, torn or removed goes with it.
+  double bending_stiffness = 0.0;
   /// Collision margin of the pieces, m.
   double margin = 0.005;
 };
@@ -74,6 +90,23 @@ struct ApplyStats {
   std::int32_t removed_links = 0, added_links = 0;
   std::int32_t moved_nodes = 0;  // nodes moved into another piece (a split)
   std::int32_t new_pieces = 0;
+  std::int32_t detached_nodes = 0;  // vertices left without faces, taken out of Bullet
+  std::int32_t removed_bending = 0, added_bending = 0;
+  std::int32_t searched_vertices = 0;  // visited by the split search
+  /// Where the wall-clock time of the last cut / drill / tear step / apply went, s. The mesh
+  /// side (sync of the simulated positions, computing the change, applying it to the mesh)
+  /// and the plugin's own mirror of it into Bullet, by phase.
+  struct Seconds {
+    double sync = 0;      // simulated positions → mesh().current
+    double mesh = 0;      // computing the change and applying it to the mesh (core)
+    double vertices = 0;  // new vertices: positions, velocities, masses
+    double faces = 0;     // removed faces and links out of Bullet, face slots
+    double pieces = 0;    // which connected piece each affected vertex belongs to
+    double split = 0;     // nodes moved into other (possibly new) bodies
+    double insert = 0;    // new nodes, faces and links into Bullet
+    double mirror() const { return vertices + faces + pieces + split + insert; }
+    double total() const { return sync + mesh + mirror(); }
+  } seconds;
 };
 
 class SkinnedSoftBody {
@@ -149,7 +182,17 @@ class SkinnedSoftBody {
   double momentum_scale() const;
   /// Our rest length of the link between two vertices (−1 when there is none).
   double rest_length(std::int32_t u, std::int32_t v) const;
+  /// Edge links (one per mesh edge) over all pieces.
   std::int32_t link_count() const;
+  /// Bending links over all pieces, and our rest length of the one across edge (u, v) (−1).
+  std::int32_t bending_link_count() const;
+  double bending_rest_length(std::int32_t u, std::int32_t v) const;
+  /// The vertex left Bullet (it has no faces): position() and velocity() are its state when
+  /// it left; body_of() is null and node_of() −1.
+  bool detached(std::int32_t vertex) const {
+    return piece_of_[static_cast<std::size_t>(vertex)] < 0;
+  }
+  std::int32_t detached_count() const { return detached_count_; }
 
   /// One substep, called by the plugin's action: pose, skin, drive nodes, re-apply rest lengths.
   void update(double dt, double time);
@@ -170,7 +213,14 @@ class SkinnedSoftBody {
   void remove_face_from_bullet(std::int32_t face);
   void remove_link(std::int32_t piece, std::int32_t link);
   void add_link(std::int32_t piece, std::int32_t u, std::int32_t v, double rest);
-  void remove_nodes(std::int32_t piece, const std::vector<std::int32_t>& vertices);
+  void add_bending(std::int32_t piece, std::int32_t a, std::int32_t b, std::int32_t c,
+                   std::int32_t d, double rest);
+  void remove_bending(std::int32_t a, std::int32_t b);
+  void refresh_bending(std::int32_t a, std::int32_t b);
+  void remove_node(std::int32_t vertex);
+  void detach(std::int32_t vertex);
+  void update_link_constants(std::int32_t vertex);
+  void update_node_area(std::int32_t vertex);
   bool is_kinematic_by_weight(std::int32_t vertex) const;
 
   btSoftBodyWorldInfo* info_;
@@ -203,6 +253,19 @@ class SkinnedSoftBody {
   std::vector<std::int32_t> face_piece_, face_slot_;
   // Per undirected edge (min, max): faces using it, and its link index in its piece.
   mesh::EdgeMap edge_faces_, edge_link_;
+  // Per undirected edge (min, max) crossed by a bending link: its link index in its piece.
+  mesh::EdgeMap bend_link_;
+  // Detached vertices: their position and velocity when they left Bullet.
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> detached_state_;
+  std::vector<std::int32_t> detached_slot_;  // per vertex, −1 unless detached
+  std::int32_t detached_count_ = 0;
+  // Split search scratch (per vertex, −1 between searches).
+  std::vector<std::int32_t> search_label_;
+  // Links removed during one change whose link may come back: (a, b, c, d, rest), where (a, b)
+  // is the key edge and (c, d) the end vertices (equal to (a, b) for an edge link).
+  std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, double>> relink_;
+  // Edges whose bending link may have to be made again at the end of a change.
+  std::vector<std::pair<std::int32_t, std::int32_t>> bend_dirty_;
 
   std::vector<std::unique_ptr<Piece>> pieces_;  // null once emptied
   ApplyStats stats_;
