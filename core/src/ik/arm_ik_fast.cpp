@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <limits>
 
 #include "conform/ik/arm_ik.hpp"
 #include "conform/ik/kernel.hpp"
@@ -63,21 +64,63 @@ Solution<T> to_solution(const detail::KernelResult<T>& r) {
   return s;
 }
 
-}  // namespace
+template <class T>
+Solution<T> invalid_arm() {
+  Solution<T> s;
+  s.status = Status::kInvalidInput;
+  return s;
+}
+
+// The scalar solves: the common case (valid input, target neither at the shoulder nor on the
+// z axis) without the rare cases' selects; the rest out of line with every case handled.
+template <class T>
+[[gnu::always_inline]] inline bool common_case(const detail::KernelConstants<T>& c, T px, T py,
+                                               T pz) {
+  const T rho2 = px * px + py * py;
+  const T r2 = rho2 + pz * pz;
+  // r2 − r2 == 0: finite (no NaN, no overflow); false for NaN in every comparison.
+  return (r2 - r2 == T(0)) & (r2 > c.tiny2) & (rho2 > c.axis_tol2 * r2);
+}
 
 template <class T>
-Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, T swivel) {
-  if (!arm.valid()) {
-    Solution<T> s;
-    s.status = Status::kInvalidInput;
-    return s;
-  }
-  const auto c = constants(arm);
-  const auto run = [&](T phi) {
-    return detail::solve_kernel<T, false>(c, target.x(), target.y(), target.z(), phi);
-  };
-  if (!arm.limits.has_cone()) return to_solution(run(swivel));
+[[gnu::noinline]] detail::KernelResult<T> rare_angle(const detail::KernelConstants<T>& c,
+                                                     const Vec3<T>& p, T phi) {
+  return detail::solve_kernel<T, detail::Path::kScalar>(c, p.x(), p.y(), p.z(), phi);
+}
 
+template <class T>
+[[gnu::noinline]] detail::KernelResult<T> rare_dir(const detail::KernelConstants<T>& c,
+                                                   const Vec3<T>& p, SwivelCosSin<T> sw) {
+  return detail::solve_kernel_dir<T, detail::Path::kScalar>(c, p.x(), p.y(), p.z(), sw.c, sw.s);
+}
+
+template <class T>
+[[gnu::always_inline]] inline detail::KernelResult<T> kernel_angle(
+    const detail::KernelConstants<T>& c, const Vec3<T>& p, T phi) {
+  const T px = p.x(), py = p.y(), pz = p.z();
+  if (common_case(c, px, py, pz) & (phi <= T(kMaxSwivel)) & (phi >= T(-kMaxSwivel))) [[likely]] {
+    const detail::SinCos<T> sc = detail::sincos_scalar(phi);
+    return detail::solve_kernel_cs<T, detail::Path::kCommon>(c, px, py, pz, sc.c, sc.s, true);
+  }
+  return rare_angle(c, p, phi);
+}
+
+template <class T>
+[[gnu::always_inline]] inline detail::KernelResult<T> kernel_dir(
+    const detail::KernelConstants<T>& c, const Vec3<T>& p, SwivelCosSin<T> sw) {
+  const T px = p.x(), py = p.y(), pz = p.z();
+  const T q = sw.c * sw.c + sw.s * sw.s;
+  // The pair is used as given when it is unit to a few ulps, else normalized (out of line).
+  const bool unit = std::abs(q - T(1)) <= T(8) * std::numeric_limits<T>::epsilon();
+  if (common_case(c, px, py, pz) & unit) [[likely]] {
+    return detail::solve_kernel_cs<T, detail::Path::kCommon>(c, px, py, pz, sw.c, sw.s, true);
+  }
+  return rare_dir(c, p, sw);
+}
+
+// With a shoulder cone: the swivel is moved (or the arm turned) by limits.hpp.
+template <class T, class Run>
+Solution<T> solve_cone(const Arm<T>& arm, T swivel, Run&& run) {
   Status extra = Status::kOk;
   bool rotate_after = false;
   const detail::KernelResult<T> probe = run(swivel);
@@ -95,8 +138,66 @@ Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, T swivel) {
   return s;
 }
 
+template <class T>
+Solution<T> solve_angle(const Arm<T>& arm, const detail::KernelConstants<T>& c,
+                        const Vec3<T>& target, T swivel) {
+  if (!arm.limits.has_cone()) [[likely]]
+    return to_solution(kernel_angle(c, target, swivel));
+  return solve_cone(arm, swivel, [&](T phi) { return kernel_angle(c, target, phi); });
+}
+
+template <class T>
+Solution<T> solve_dir(const Arm<T>& arm, const detail::KernelConstants<T>& c, const Vec3<T>& target,
+                      SwivelCosSin<T> swivel) {
+  if (!arm.limits.has_cone()) [[likely]]
+    return to_solution(kernel_dir(c, target, swivel));
+  // The cone works on angles. An invalid pair stays invalid (the kernel reports it).
+  const detail::KernelResult<T> probe = kernel_dir(c, target, swivel);
+  if (probe.status & detail::kBitInvalid) return to_solution(probe);
+  return solve_cone(arm, std::atan2(swivel.s, swivel.c),
+                    [&](T phi) { return kernel_angle(c, target, phi); });
+}
+
+}  // namespace
+
+template <class T>
+Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, T swivel) {
+  if (!arm.valid()) return invalid_arm<T>();
+  return solve_angle(arm, constants(arm), target, swivel);
+}
+
+template <class T>
+Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, SwivelCosSin<T> swivel) {
+  if (!arm.valid()) return invalid_arm<T>();
+  return solve_dir(arm, constants(arm), target, swivel);
+}
+
 template Solution<float> solve(const Arm<float>&, const Vec3<float>&, float);
 template Solution<double> solve(const Arm<double>&, const Vec3<double>&, double);
+template Solution<float> solve(const Arm<float>&, const Vec3<float>&, SwivelCosSin<float>);
+template Solution<double> solve(const Arm<double>&, const Vec3<double>&, SwivelCosSin<double>);
+
+template <class T>
+ArmSolver<T>::ArmSolver(const Arm<T>& arm) : arm_(arm), valid_(arm.valid()) {
+  if (valid_) constants_ = constants(arm);
+}
+
+template <class T>
+Solution<T> ArmSolver<T>::solve(const Vec3<T>& target, T swivel) const {
+  if (!valid_) [[unlikely]]
+    return invalid_arm<T>();
+  return solve_angle(arm_, constants_, target, swivel);
+}
+
+template <class T>
+Solution<T> ArmSolver<T>::solve(const Vec3<T>& target, SwivelCosSin<T> swivel) const {
+  if (!valid_) [[unlikely]]
+    return invalid_arm<T>();
+  return solve_dir(arm_, constants_, target, swivel);
+}
+
+template class ArmSolver<float>;
+template class ArmSolver<double>;
 
 // ----- batch -----
 

@@ -16,11 +16,16 @@
 // - Elbow: Qe = cos(θ4/2) + sin(θ4/2) i, θ4 ∈ [0, π] the flexion (0 = straight); the forearm
 //   swings towards local −y. The hinge axis in the world is Qs·x̂ = −n̂.
 //
+// - Qs is returned with qs.w ≥ 0 (q and −q are the same rotation).
+//
 // Three solvers give the same answer: solve_readable (the algebra, arm_ik_readable.cpp),
-// solve (the closed form, scalar) and BatchSolveJob (the closed form over structure-of-arrays
-// data, SIMD and OpenMP threads). See arm_ik_readable.cpp for every sign changed vs the paper.
+// solve / ArmSolver (the closed form, scalar) and BatchSolveJob (the closed form over
+// structure-of-arrays data, SIMD and OpenMP threads). See arm_ik_readable.cpp for every sign
+// changed vs the paper. For many solves with one arm, ArmSolver computes the arm's constants
+// once; solve(arm, …) computes them on every call.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <numbers>
 #include <span>
@@ -28,6 +33,7 @@
 
 #include "conform/cga/motor.hpp"
 #include "conform/cga/point.hpp"
+#include "conform/ik/kernel.hpp"
 
 namespace conform::ik {
 
@@ -116,9 +122,43 @@ ForwardResult<T> forward_kinematics(const Arm<T>& arm, const Quat<T>& qs, const 
   return {s * Vec3<T>(0, 0, arm.upper), s * (Vec3<T>(0, 0, arm.upper) + fore)};
 }
 
+/// The swivel angle φ given as (c, s) = (cos φ, sin φ): for callers that have the pair (a
+/// swivel that repeats, or one given as a direction), it saves the solver's sine and cosine.
+/// Any positive multiple of the pair is accepted (it is normalized); (0, 0) or a non-finite
+/// pair is invalid input.
+template <class T = double>
+struct SwivelCosSin {
+  T c = T(1), s = T(0);
+  static SwivelCosSin from_angle(T phi) { return {std::cos(phi), std::sin(phi)}; }
+};
+
 /// Fast closed form (eqs 10–18 re-derived for accuracy), one target. Honours all limits.
+/// Computes the arm's constants on every call; ArmSolver keeps them.
 template <class T>
 Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, T swivel);
+template <class T>
+Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, SwivelCosSin<T> swivel);
+
+/// The fast closed form for one arm: the arm's constants (lengths, squares, reciprocals and
+/// the elbow range's reach) are computed once, here. Same results as solve(arm, …).
+template <class T = double>
+class ArmSolver {
+ public:
+  explicit ArmSolver(const Arm<T>& arm = Arm<T>{});
+  const Arm<T>& arm() const { return arm_; }
+  /// False for an invalid arm (then every solve returns kInvalidInput).
+  bool valid() const { return valid_; }
+  Solution<T> solve(const Vec3<T>& target, T swivel) const;
+  Solution<T> solve(const Vec3<T>& target, SwivelCosSin<T> swivel) const;
+
+ private:
+  Arm<T> arm_;
+  detail::KernelConstants<T> constants_{};
+  bool valid_ = false;
+};
+
+extern template class ArmSolver<float>;
+extern template class ArmSolver<double>;
 
 /// The geometric version written with the algebra: spheres, circle Ze = S1∧S2, swivel plane,
 /// point pair Pp = Ze∧π, lines L_se, L_ew, angles by eq 5, quaternions by eqs 8, 9, 14–18.

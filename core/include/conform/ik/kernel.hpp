@@ -1,34 +1,42 @@
-// The closed-form IK kernel shared by the scalar solver and the SIMD batch: branch-free
-// (every choice is a select), no library calls, so that `#pragma omp simd` loops vectorize
-// it. Internal: use conform/ik/arm_ik.hpp.
+// The closed-form IK kernel shared by the scalar solvers and the SIMD batch: no library
+// calls, and in the vector path branch-free (every choice is a select), so that
+// `#pragma omp simd` loops vectorize it. Internal: use conform/ik/arm_ik.hpp.
 //
-// It is eqs 10–18 of the first paper re-derived from the geometry. With P̂ = Pw/L, L = |Pw|,
-// and the triangle factors f1 = d1+d2−L, f2 = L+d1−d2, f3 = L−d1+d2, f4 = L+d1+d2 (all ≥ 0
-// once L is clamped to the shell):
-//   eq 11  n(φ) = cos φ (P̂×r) + sin φ P̂×(P̂×r),  r = ẑ (x̂ on the z axis); |n| = |P̂×r|
-//   eq 12  Pp's coefficients collapse to tmp1 = |n|²·f1 f2 f3 f4/4 (§4.2's PP± products)
-//   eq 13  elbow = a P̂ + h û,  û = n̂×P̂,  a = (L² + (d1−d2)(d1+d2))/(2L),
-//          h = √(f1f2f3f4)/(2L) = 2 d1 d2 cos(θ4/2) sin(θ4/2)/L
-//   eq 14  cos(θ4/2) = √(f2 f3)/(2√(d1d2)),  sin(θ4/2) = √(f1 f4)/(2√(d1d2))   (no 1 − c)
-//   eq 15  Q12 = half-turn about the bisector m = ê + σẑ, σ = sign(e_z); for σ < 0 the
-//          bisector of ê and −ẑ composed with a half-turn about x: Q12 = (0, m̂)·i
-//   eq 17  c3 = −(Q12 x̂)·n̂,  s3 = −(Q12 ŷ)·n̂,  Q3 = half-angle of (c3, s3)
-//   eq 18  Qs = Q12 Q3
-// Half-angles use t = √((1+|c|)/2), u = s/(2t): accurate for every angle, unlike √((1−c)/2).
-//
-// Cost per solve: 6 square roots and 4 divisions (scalar path; the paper's Table 4, optimized:
-// 8 roots, 10 divisions), about 130 multiplications and additions, and a polynomial sincos of
-// φ (the paper's pipeline takes cos(φ/2), sin(φ/2) as inputs). In the vector path there is no
-// division and no std::sqrt: GCC keeps sqrt's errno path (a call per element) unless the whole
-// build uses -fno-math-errno, which would block vectorization; every root and reciprocal there
-// is rsqrt() below (bit-trick seed + Newton, to the last ulp or two), which vectorizes.
+// It is eqs 10–18 of the first paper re-derived from the geometry, with Qs taken from the
+// upper arm's frame instead of the paper's product Q12·Q3. With P̂ = Pw/L, L = |Pw| (clamped
+// to the shell, the clamp done on L² = |Pw|² so that no root is waited for):
+//   eq 11  n(φ) = cos φ n̂0 + sin φ P̂×n̂0,  n̂0 = (P̂×r)/|P̂×r|,  r = ẑ (x̂ on the z axis)
+//   eq 12  Pp's coefficients collapse to tmp1 = |n|²·f1 f2 f3 f4/4 (§4.2's PP± products), with
+//          the triangle factors f1 f4 = (d1+d2)² − L², f2 f3 = L² − (d1−d2)²: no |Pw| needed
+//   eq 14  cos(θ4/2) = √(f2 f3 / (4 d1 d2)),  sin(θ4/2) = √(f1 f4 / (4 d1 d2))   (no 1 − c)
+//   eq 13  elbow = d1 ê,  ê = cos α P̂ + sin α û,  û = n̂×P̂, α the angle at the shoulder:
+//          cos α = (L² + d1² − d2²)/(2 L d1),  sin α = 2 d2 cos(θ4/2) sin(θ4/2)/L
+//   eqs 15–18  Qs maps the rest frame (x̂, ŷ, ẑ) onto the upper arm's (−n̂, ŷ', ê),
+//          ŷ' = cos α û − sin α P̂ (the hinge is Qs·x̂ = −n̂, as with Q12·Q3); its quaternion
+//          by Shepperd's method with the pivot chosen as in Day (2015): the pivot's 4q² ≥ 1,
+//          so one root and no cancellation. Sign: qs.w ≥ 0.
+// Cost per solve: 5 square roots (4 independent ones on the inputs, 1 for Qs) and 3 divisions
+// in the scalar path, about 110 multiplications and additions, and a polynomial sincos of φ
+// unless (cos φ, sin φ) is given (the paper's pipeline takes cos(φ/2), sin(φ/2) as inputs;
+// its Table 4, optimized: 8 roots, 10 divisions). The longest chain has two root+division
+// steps (|Pw|, then Qs); the Q12·Q3 form (kernel_q12.hpp) had four.
+// In the vector path there is no division and no std::sqrt: GCC keeps sqrt's errno path (a
+// call per element) unless the whole build uses -fno-math-errno, which would block
+// vectorization; every root and reciprocal there is rsqrt() below (bit-trick seed + Newton,
+// to the last ulp or two), which vectorizes.
 #pragma once
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <type_traits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace conform::ik::detail {
 
@@ -75,40 +83,32 @@ struct SinCos {
   T s, c;
 };
 
-// sin and cos for |x| ≤ kMaxSwivel: x = k π/2 + r with a three-part π/2 (Cody–Waite),
-// Cephes minimax polynomials on |r| ≤ π/4, quadrant by selects.
-[[gnu::always_inline]] inline SinCos<double> sincos(double x) {
+/// sin and cos of the reduced argument r, |r| ≤ π/4, and the quadrant q: x = q π/2 + r.
+template <class T>
+struct ReducedSinCos {
+  T s, c;
+  int q;
+};
+
+// For |x| ≤ kMaxSwivel: x = k π/2 + r with a three-part π/2 (Cody–Waite), Cephes minimax
+// polynomials on |r| ≤ π/4 (evaluated by Estrin's scheme: a shorter chain than Horner's).
+[[gnu::always_inline]] inline ReducedSinCos<double> sincos_reduced(double x) {
   constexpr double kShifter = 6755399441055744.0;  // 1.5·2^52: adding it rounds to integer
   const double k = (x * 0.63661977236758134308 + kShifter) - kShifter;
-  double r = x - k * 1.57079632673412561417e+00;  // π/2 in 33 + 33 + 53 bits (fdlibm)
-  r = r - k * 6.07710050630396597660e-11;
-  r = r - k * 2.02226624879595063154e-21;
-  const double z = r * r;
-  const double sp = ((((1.58962301576546568060e-10 * z - 2.50507477628578072866e-8) * z +
-                       2.75573136213857245213e-6) *
-                          z -
-                      1.98412698295895385996e-4) *
-                         z +
-                     8.33333333332211858878e-3) *
-                        z -
-                    1.66666666666666307295e-1;
-  const double cp = ((((-1.13585365213876817300e-11 * z + 2.08757008419747316778e-9) * z -
-                       2.75573141792967388112e-7) *
-                          z +
-                      2.48015872888517045348e-5) *
-                         z -
-                     1.38888888888730564116e-3) *
-                        z +
-                    4.16666666666665929218e-2;
-  const double sr = r + r * z * sp;
-  const double cr = 1.0 - 0.5 * z + z * z * cp;
-  const int q = static_cast<int>(k);
-  const double s = sel((q & 1) != 0, cr, sr);
-  const double c = sel((q & 1) != 0, sr, cr);
-  return {sel((q & 2) != 0, -s, s), sel(((q + 1) & 2) != 0, -c, c)};
+  const double r = ((x - k * 1.57079632673412561417e+00)  // π/2 in 33 + 33 + 53 bits (fdlibm)
+                    - k * 6.07710050630396597660e-11) -
+                   k * 2.02226624879595063154e-21;
+  const double z = r * r, z2 = z * z, z4 = z2 * z2;
+  const double sp = (-1.66666666666666307295e-1 + 8.33333333332211858878e-3 * z) +
+                    z2 * (-1.98412698295895385996e-4 + 2.75573136213857245213e-6 * z) +
+                    z4 * (-2.50507477628578072866e-8 + 1.58962301576546568060e-10 * z);
+  const double cp = (4.16666666666665929218e-2 - 1.38888888888730564116e-3 * z) +
+                    z2 * (2.48015872888517045348e-5 - 2.75573141792967388112e-7 * z) +
+                    z4 * (2.08757008419747316778e-9 - 1.13585365213876817300e-11 * z);
+  return {r + (r * z) * sp, (1.0 - 0.5 * z) + z2 * cp, static_cast<int>(k)};
 }
 
-[[gnu::always_inline]] inline SinCos<float> sincos(float x) {
+[[gnu::always_inline]] inline ReducedSinCos<float> sincos_reduced(float x) {
   constexpr float kShifter = 12582912.0f;  // 1.5·2^23
   const float k = (x * 0.636619772f + kShifter) - kShifter;
   float r = x - k * 1.5703125f;  // Cephes' π/2 split
@@ -119,59 +119,86 @@ struct SinCos {
   const float cr =
       ((2.443315711809948e-5f * z - 1.388731625493765e-3f) * z + 4.166664568298827e-2f) * z * z -
       0.5f * z + 1.0f;
-  const int q = static_cast<int>(k);
-  const float s = sel((q & 1) != 0, cr, sr);
-  const float c = sel((q & 1) != 0, sr, cr);
+  return {sr, cr, static_cast<int>(k)};
+}
+
+/// sin and cos for |x| ≤ kMaxSwivel, the quadrant by selects (vectorizes).
+template <class T>
+[[gnu::always_inline]] inline SinCos<T> sincos(T x) {
+  const ReducedSinCos<T> r = sincos_reduced(x);
+  const int q = r.q;
+  const T s = sel((q & 1) != 0, r.c, r.s);
+  const T c = sel((q & 1) != 0, r.s, r.c);
   return {sel((q & 2) != 0, -s, s), sel(((q + 1) & 2) != 0, -c, c)};
 }
 
-/// Per-arm constants, computed once per solve or per batch.
+/// The same for one solve: (c, s) turned by q quarter turns with factors 0, ±1 from a table
+/// (exact: one of each pair of products is 0), loaded while the polynomials are evaluated.
+template <class T>
+[[gnu::always_inline]] inline SinCos<T> sincos_scalar(T x) {
+  static constexpr T kCos[4] = {1, 0, -1, 0};
+  static constexpr T kSin[4] = {0, 1, 0, -1};
+  const ReducedSinCos<T> r = sincos_reduced(x);
+  const T a = kCos[r.q & 3], b = kSin[r.q & 3];
+  return {r.s * a + r.c * b, r.c * a - r.s * b};
+}
+
+/// Per-arm constants, computed once per ArmSolver or batch (or per call of the free solve()).
 template <class T>
 struct KernelConstants {
-  T d1, d2;
-  T reach_max, reach_min;  // clamp range of |Pw| (elbow limits included)
-  T geo_max, geo_min;      // d1 + d2, |d1 − d2| (what is reachable at all)
-  T d1_minus_d2;
-  T dd;        // (d1 − d2)(d1 + d2), accurate when d1 ≈ d2
-  T k_half;    // 1 / (2 √(d1 d2))
-  T two_d1d2;  // 2 d1 d2
-  T inv_d1;
-  T tiny, tiny2;  // |Pw| below this is "at the shoulder"; its square
+  T d1;
+  T reach_max, reach_min;    // clamp range of |Pw| (elbow limits included)
+  T reach_max2, reach_min2;  // the same for |Pw|²
+  T geo_max, geo_min;        // d1 + d2, |d1 − d2| (what is reachable at all)
+  T sum2, diff2;             // (d1 + d2)², (d1 − d2)²
+  T dd;                      // (d1 − d2)(d1 + d2), accurate when d1 ≈ d2
+  T k2;                      // 1 / (4 d1 d2)
+  T half_inv_d1;             // 1 / (2 d1)
+  T two_d2;                  // 2 d2
+  T tiny, tiny2;             // |Pw| below this is "at the shoulder"; its square
   T inv_reach_max, inv_reach_min;
   bool limit_max, limit_min;  // the elbow range narrows reach_max / reach_min
   T axis_tol2;                // (64 ε)²: squared sine of the angle to the z axis
 
   static KernelConstants make(double d1, double d2, double flex_min, double flex_max) {
     KernelConstants c{};
-    c.d1 = T(d1), c.d2 = T(d2);
-    c.geo_max = T(d1 + d2), c.geo_min = T(std::abs(d1 - d2));
-    // |Pw| as a function of the flexion: L(θ)² = d1² + d2² + 2 d1 d2 cos θ.
-    const auto reach = [&](double flex) {
-      return std::sqrt(std::max(0.0, d1 * d1 + d2 * d2 + 2 * d1 * d2 * std::cos(flex)));
-    };
-    const double lmax = flex_min > 0 ? reach(flex_min) : d1 + d2;
-    const double lmin = flex_max < std::numbers::pi ? reach(flex_max) : std::abs(d1 - d2);
-    const double tiny = 64 * std::numeric_limits<T>::epsilon() * (d1 + d2);
-    c.reach_max = flex_min > 0 ? T(lmax) : c.geo_max;
-    c.reach_min = T(std::max(lmin, tiny));
-    c.d1_minus_d2 = T(d1 - d2);
-    c.dd = T((d1 - d2) * (d1 + d2));
-    c.k_half = T(0.5 / std::sqrt(d1 * d2));
-    c.two_d1d2 = T(2 * d1 * d2);
-    c.inv_d1 = T(1 / d1);
+    c.d1 = T(d1);
+    const double sum = d1 + d2, diff = d1 - d2;
+    c.geo_max = T(sum), c.geo_min = T(std::abs(diff));
+    // |Pw|² as a function of the flexion θ: (d1+d2)² − 4 d1 d2 sin²(θ/2)
+    // = (d1−d2)² + 4 d1 d2 cos²(θ/2), each written where it has no cancellation.
+    c.limit_max = flex_min > 0;
+    c.limit_min = flex_max < std::numbers::pi;
+    double lmax2 = sum * sum, lmin2 = diff * diff;
+    if (c.limit_max) {
+      const double s = std::sin(flex_min / 2);
+      lmax2 -= 4 * d1 * d2 * s * s;
+    }
+    if (c.limit_min) {
+      const double co = std::cos(flex_max / 2);
+      lmin2 += 4 * d1 * d2 * co * co;
+    }
+    const double tiny = 64 * std::numeric_limits<T>::epsilon() * sum;
+    const double lmax = c.limit_max ? std::sqrt(lmax2) : sum;
+    const double lmin = std::max(c.limit_min ? std::sqrt(lmin2) : std::abs(diff), tiny);
+    c.reach_max = T(lmax), c.reach_min = T(lmin);
+    c.reach_max2 = T(lmax2), c.reach_min2 = T(std::max(lmin2, tiny * tiny));
+    c.sum2 = T(sum * sum), c.diff2 = T(diff * diff);
+    c.dd = T(diff * sum);
+    c.k2 = T(0.25 / (d1 * d2));
+    c.half_inv_d1 = T(0.5 / d1);
+    c.two_d2 = T(2 * d2);
     c.tiny = T(tiny);
     c.tiny2 = T(tiny * tiny);
     c.inv_reach_max = T(1) / c.reach_max;
     c.inv_reach_min = T(1) / c.reach_min;
-    c.limit_max = flex_min > 0;
-    c.limit_min = flex_max < std::numbers::pi;
     const double tol = 64 * std::numeric_limits<T>::epsilon();
     c.axis_tol2 = T(tol * tol);
     return c;
   }
 };
 
-// Select-based min/max/abs (fmin/fmax do not vectorize without -ffast-math).
+// Select-based min/max (fmin/fmax do not vectorize without -ffast-math).
 template <class T>
 [[gnu::always_inline]] inline T max0(T x, T lo) {
   return sel(x < lo, lo, x);
@@ -193,117 +220,199 @@ struct KernelResult {
 inline constexpr std::uint8_t kBitOuter = 1, kBitInner = 2, kBitShoulder = 4, kBitTargetAxis = 8,
                               kBitElbowAxis = 16, kBitElbowLimit = 32, kBitInvalid = 128;
 
-/// kVector: roots by rsqrt() (vectorizes); otherwise by std::sqrt and division, whose latency
-/// is shorter for one solve at a time (the results agree to an ulp or two).
-template <class T, bool kVector = true>
-[[gnu::always_inline]] inline KernelResult<T> solve_kernel(const KernelConstants<T>& c, T px, T py,
-                                                           T pz, T phi) {
-  const auto rsqrt = [](T x) {
+/// Selects and roots of the vector path: bool conditions, sel(), rsqrt() and sqrt() above.
+template <class T>
+struct VectorOps {
+  using Mask = bool;
+  [[gnu::always_inline]] static Mask less(T a, T b) { return a < b; }
+  [[gnu::always_inline]] static T pick(Mask m, T a, T b) { return sel(m, a, b); }
+  [[gnu::always_inline]] static T sqrt(T x) { return detail::sqrt(x); }
+  [[gnu::always_inline]] static T rsqrt(T x) { return detail::rsqrt(x); }
+};
+
+/// Selects and roots for one solve. With SSE2 the comparison masks stay in the vector
+/// registers (sel() goes through the integer registers when it is not vectorized, and a plain
+/// ?: becomes a branch, mispredicted with random targets) and the roots skip std::sqrt's errno
+/// check (its arguments here are never negative).
+template <class T>
+struct ScalarOps {
+  using Mask = bool;
+  [[gnu::always_inline]] static Mask less(T a, T b) { return a < b; }
+  [[gnu::always_inline]] static T pick(Mask m, T a, T b) { return sel(m, a, b); }
+  static T sqrt(T x) { return std::sqrt(x); }
+  static T rsqrt(T x) { return T(1) / std::sqrt(x); }
+};
+#if defined(__SSE2__)
+template <>
+struct ScalarOps<double> {
+  struct Mask {
+    __m128d m;
+  };
+  [[gnu::always_inline]] static Mask less(double a, double b) {
+    return {_mm_cmplt_sd(_mm_set_sd(a), _mm_set_sd(b))};
+  }
+  [[gnu::always_inline]] static double pick(Mask m, double a, double b) {
+    return _mm_cvtsd_f64(
+        _mm_or_pd(_mm_and_pd(m.m, _mm_set_sd(a)), _mm_andnot_pd(m.m, _mm_set_sd(b))));
+  }
+  [[gnu::always_inline]] static double sqrt(double x) {
+    const __m128d v = _mm_set_sd(x);
+    return _mm_cvtsd_f64(_mm_sqrt_sd(v, v));
+  }
+  [[gnu::always_inline]] static double rsqrt(double x) { return 1.0 / sqrt(x); }
+};
+template <>
+struct ScalarOps<float> {
+  struct Mask {
+    __m128 m;
+  };
+  [[gnu::always_inline]] static Mask less(float a, float b) {
+    return {_mm_cmplt_ss(_mm_set_ss(a), _mm_set_ss(b))};
+  }
+  [[gnu::always_inline]] static float pick(Mask m, float a, float b) {
+    return _mm_cvtss_f32(
+        _mm_or_ps(_mm_and_ps(m.m, _mm_set_ss(a)), _mm_andnot_ps(m.m, _mm_set_ss(b))));
+  }
+  [[gnu::always_inline]] static float sqrt(float x) {
+    return _mm_cvtss_f32(_mm_sqrt_ss(_mm_set_ss(x)));
+  }
+  [[gnu::always_inline]] static float rsqrt(float x) { return 1.0f / sqrt(x); }
+};
+#endif
+
+/// The paths of solve_kernel_cs.
+enum class Path {
+  kVector,  // SIMD lanes: every case by selects, roots by rsqrt()
+  kScalar,  // one solve: every case by selects, roots by std::sqrt and division
+  kCommon,  // one solve, the caller has checked: valid input, not at the shoulder, not on the
+            // z axis (the three rare cases' selects are left out)
+};
+
+/// One solve from the target and the swivel as (cos φ, sin φ), a unit pair. `swivel_ok`
+/// false or a non-finite target gives the identity pose with kBitInvalid.
+template <class T, Path kPath = Path::kVector>
+[[gnu::always_inline]] inline KernelResult<T> solve_kernel_cs(const KernelConstants<T>& c, T px,
+                                                              T py, T pz, T cphi, T sphi,
+                                                              bool swivel_ok) {
+  constexpr bool kVector = kPath == Path::kVector;
+  constexpr bool kRare = kPath != Path::kCommon;  // handle the rare cases here
+  using Ops = std::conditional_t<kVector, VectorOps<T>, ScalarOps<T>>;
+  // Clamps: selects for the vectorizer, min/max instructions for one solve.
+  const auto at_least = [](T x, T lo) {
     if constexpr (kVector) {
-      return detail::rsqrt(x);
+      return max0(x, lo);
     } else {
-      return T(1) / std::sqrt(x);
+      return x < lo ? lo : x;
     }
   };
-  const auto sqrt = [](T x) {
+  const auto at_most = [](T x, T hi) {
     if constexpr (kVector) {
-      return detail::sqrt(x);
+      return min0(x, hi);
     } else {
-      return std::sqrt(x);
+      return x > hi ? hi : x;
     }
   };
-  // Invalid input (NaN, ±inf, |P|² overflow, huge φ): solve a harmless target, report it.
+
   const T r2_in = px * px + py * py + pz * pz;
-  // Bitwise & and | on the conditions (not && ||): no branches for the vectorizer.
-  const bool valid = (r2_in - r2_in == T(0)) & (phi <= T(1e4)) & (phi >= T(-1e4));
-  px = sel(valid, px, T(0));
-  py = sel(valid, py, T(0));
-  pz = sel(valid, pz, T(1));
-  phi = sel(valid, phi, T(0));
-  const T r2 = sel(valid, r2_in, T(1));
+  bool valid = true, at_shoulder = false, on_axis = false;
+  T r2 = r2_in;
+  if constexpr (kRare) {
+    // Invalid input (NaN, ±inf, |P|² overflow, bad swivel): solve a harmless target, report
+    // it. Bitwise & and | on the conditions (not && ||): no branches for the vectorizer.
+    valid = (r2_in - r2_in == T(0)) & swivel_ok;
+    px = sel(valid, px, T(0));
+    py = sel(valid, py, T(0));
+    pz = sel(valid, pz, T(1));
+    cphi = sel(valid, cphi, T(1));
+    sphi = sel(valid, sphi, T(0));
+    r2 = sel(valid, r2_in, T(1));
+    at_shoulder = r2 <= c.tiny2;
+    px = sel(at_shoulder, T(0), px);  // the direction of a target at the shoulder is +z
+    py = sel(at_shoulder, T(0), py);
+    pz = sel(at_shoulder, T(1), pz);
+  }
+  const T r2d = kRare ? sel(at_shoulder, T(1), r2) : r2;  // |P|² of the direction used
+  const T r2s = kRare ? sel(at_shoulder, T(0), r2) : r2;  // |Pw|²
 
-  // Direction and clamped distance (eq 10). The roots below depend on the inputs only, so
-  // they run side by side (short latency for one solve).
-  const bool at_shoulder = r2 <= c.tiny2;
-  px = sel(at_shoulder, T(0), px);  // the direction of a target at the shoulder is +z
-  py = sel(at_shoulder, T(0), py);
-  pz = sel(at_shoulder, T(1), pz);
-  const T r2d = sel(at_shoulder, T(1), r2);
-  const T inv_r = rsqrt(r2d);
-  const T l0 = sel(at_shoulder, T(0), r2d * inv_r);
-  const T ux = px * inv_r, uy = py * inv_r, uz = pz * inv_r;  // P̂
-  const T l = min0(max0(l0, c.reach_min), c.reach_max);
-  const T inv_l =
-      sel(l0 > c.reach_max, c.inv_reach_max, sel(l0 < c.reach_min, c.inv_reach_min, inv_r));
-
-  // Swivel reference (eq 11): n0 = Pw × r, r = ẑ (x̂ when Pw is on the z axis); n̂0 and
-  // ĝ = P̂ × n̂0 = (Pw × n0)/(|Pw||n0|) span the plane normal to Pw.
+  // The roots that depend on the inputs only run side by side: 1/|P|, 1/|n0| and the
+  // half-angles of the flexion (eq 14) from the clamped |Pw|².
+  const T inv_r = Ops::rsqrt(r2d);
+  // diff2 ≤ reach_min2 ≤ l2 ≤ reach_max2 ≤ sum2 (also after rounding): both factors ≥ 0.
+  const T l2 = at_most(at_least(r2s, c.reach_min2), c.reach_max2);
+  const T ce = Ops::sqrt((l2 - c.diff2) * c.k2);  // cos(θ4/2)
+  const T se = Ops::sqrt((c.sum2 - l2) * c.k2);   // sin(θ4/2)
+  // Swivel reference (eq 11): n0 = P × r, r = ẑ (x̂ when P is on the z axis); n̂0 and
+  // ĝ = P̂ × n̂0 = (P × n0)/(|P||n0|) span the plane normal to P.
   const T rho2 = px * px + py * py;
-  const bool on_axis = rho2 <= c.axis_tol2 * r2d;
-  const T n0x = sel(on_axis, T(0), py);
-  const T n0y = sel(on_axis, pz, -px);
-  const T n0z = sel(on_axis, -py, T(0));
-  const T inv_n0 = rsqrt(sel(on_axis, py * py + pz * pz, rho2));
+  if constexpr (kRare) on_axis = rho2 <= c.axis_tol2 * r2d;
+  const T n0x = kRare ? sel(on_axis, T(0), py) : py;
+  const T n0y = kRare ? sel(on_axis, pz, -px) : -px;
+  const T n0z = kRare ? sel(on_axis, -py, T(0)) : T(0);
+  const T inv_n0 = Ops::rsqrt(kRare ? sel(on_axis, py * py + pz * pz, rho2) : rho2);
+
+  // The clamped distance (eq 10): the clamp decides 1/L.
+  const T l0 = kRare ? sel(at_shoulder, T(0), r2d * inv_r) : r2d * inv_r;
+  const T inv_l = Ops::pick(Ops::less(c.reach_max2, r2s), c.inv_reach_max,
+                            Ops::pick(Ops::less(r2s, c.reach_min2), c.inv_reach_min, inv_r));
+
+  const T ux = px * inv_r, uy = py * inv_r, uz = pz * inv_r;        // P̂
   const T ax = n0x * inv_n0, ay = n0y * inv_n0, az = n0z * inv_n0;  // n̂0
   const T inv_rn = inv_r * inv_n0;
   const T gx = (py * n0z - pz * n0y) * inv_rn, gy = (pz * n0x - px * n0z) * inv_rn,
           gz = (px * n0y - py * n0x) * inv_rn;  // P̂ × n̂0
-  const SinCos<T> sc = sincos(phi);
-  const T nx = sc.c * ax + sc.s * gx, ny = sc.c * ay + sc.s * gy, nz = sc.c * az + sc.s * gz;
-  const T wx = sc.s * ax - sc.c * gx, wy = sc.s * ay - sc.c * gy, wz = sc.s * az - sc.c * gz;  // û
+  const T nx = cphi * ax + sphi * gx, ny = cphi * ay + sphi * gy, nz = cphi * az + sphi * gz;
+  const T wx = sphi * ax - cphi * gx, wy = sphi * ay - cphi * gy,
+          wz = sphi * az - cphi * gz;  // û = n̂ × P̂
 
-  // Elbow flexion (eq 14) from the triangle factors.
-  const T f1 = max0(c.geo_max - l, T(0));
-  const T f2 = max0(l + c.d1_minus_d2, T(0));
-  const T f3 = max0(l - c.d1_minus_d2, T(0));
-  const T f4 = c.geo_max + l;
-  const T ce = sqrt(f2 * f3) * c.k_half;  // cos(θ4/2)
-  const T se = sqrt(f1 * f4) * c.k_half;  // sin(θ4/2)
+  // The angle α at the shoulder between L_sw and L_se (eqs 12–13: a = d1 cos α, h = d1 sin α).
+  const T ca = (l2 + c.dd) * inv_l * c.half_inv_d1;
+  const T sa = c.two_d2 * ce * se * inv_l;
+  const T ex = ca * ux + sa * wx, ey = ca * uy + sa * wy, ez = ca * uz + sa * wz;  // ê
+  const T yx = ca * wx - sa * ux, yy = ca * wy - sa * uy, yz = ca * wz - sa * uz;  // ŷ'
 
-  // Elbow point (eqs 12–13): a = d1 cos α, h = d1 sin α.
-  const T a = (l * l + c.dd) * (T(0.5) * inv_l);
-  const T h = c.two_d1d2 * ce * se * inv_l;
-  const T pex = a * ux + h * wx, pey = a * uy + h * wy, pez = a * uz + h * wz;
+  // Qs: the rotation with columns (−n̂, ŷ', ê), Shepperd's method. The four candidates
+  // 4q² = 1 ± r00 ± r11 ± r22 and the pivot of Day (2015), whose 4q² ≥ 1.
+  const T r00 = -nx, r11 = yy, r22 = ez;
+  const T a0 = T(1) + r00, b0 = T(1) - r00, p0 = r11 + r22, m0 = r11 - r22;
+  const auto low = Ops::less(r22, T(0));
+  const auto c01 = Ops::less(r11, r00);   // (low) x, else y
+  const auto c0m = Ops::less(r00, -r11);  // (!low) z, else w
+  const T tw = a0 + p0, tx = a0 - p0, ty = b0 + m0, tz = b0 - m0;
+  const auto pick = [](auto m, T a, T b) { return Ops::pick(m, a, b); };
+  const T t = pick(low, pick(c01, tx, ty), pick(c0m, tz, tw));
+  // Off-diagonal sums and differences (R_ij = column j, row i).
+  const T dwx = yz - ey;   // R21 − R12
+  const T dwy = ex + nz;   // R02 − R20
+  const T dwz = -ny - yx;  // R10 − R01
+  const T sxy = yx - ny;   // R01 + R10
+  const T sxz = ex - nz;   // R02 + R20
+  const T syz = ey + yz;   // R12 + R21
+  const T vw = pick(low, pick(c01, dwx, dwy), pick(c0m, dwz, t));
+  const T vx = pick(low, pick(c01, t, sxy), pick(c0m, sxz, dwx));
+  const T vy = pick(low, pick(c01, sxy, t), pick(c0m, syz, dwy));
+  const T vz = pick(low, pick(c01, sxz, syz), pick(c0m, t, dwz));
+  // q = v / (2√t); the sign makes w ≥ 0.
+  const T half_rt = T(0.5) * Ops::rsqrt(t);
+  const T k = pick(Ops::less(vw, T(0)), -half_rt, half_rt);
 
-  // Q12 (eq 15): half-turn about the bisector of ê and σẑ. Eq 15 is (d1 − pez)(Pe + d1ẑ)
-  // normalized; its factor (d1 − pez) is dropped (0/0 with the elbow at +d1ẑ), and below the
-  // xy plane the −ẑ bisector avoids the 0/0 at −d1ẑ.
-  const T ex = pex * c.inv_d1, ey = pey * c.inv_d1, ez = pez * c.inv_d1;
-  const bool upper = ez >= T(0);
-  const T mz = sel(upper, ez + T(1), ez - T(1));
-  const T m2 = ex * ex + ey * ey + mz * mz;
-  const T inv_m = rsqrt(m2);
-  const T q12w = sel(upper, T(0), -ex * inv_m);
-  const T q12x = sel(upper, ex * inv_m, T(0));
-  const T q12y = sel(upper, ey * inv_m, mz * inv_m);
-  const T q12z = sel(upper, mz * inv_m, -ey * inv_m);
-
-  // Q3 (eqs 16–17): rotation about local z taking x̂ to Q12⁻¹(−n̂); with the reflection
-  // w = 2(m̂·n̂)m̂ − n̂: c3 = −w_x, s3 = −σ w_y.
-  const T t = T(2) * (ex * nx + ey * ny + mz * nz) * (inv_m * inv_m);
-  const T c3 = nx - t * ex;
-  const T s3 = sel(upper, ny - t * ey, t * ey - ny);
-  const T hh = T(0.5) * (T(1) + std::fabs(c3));
-  const T inv_h3 = rsqrt(hh);
-  const T h3 = hh * inv_h3;
-  const T v3 = s3 * T(0.5) * inv_h3;
-  const T q3w = sel(c3 >= T(0), h3, std::fabs(v3));
-  // The sign of sin(θ3/2) is that of s3, not eq 17's sign(πyz2·Pw), which is 0/0 when the
-  // arm is straight.
-  const T q3z = sel(c3 >= T(0), v3, sel(s3 >= T(0), h3, -h3));
-
-  // Qs = Q12 Q3 (eq 18; q12w = 0 on the upper hemisphere, as in the paper).
   KernelResult<T> r;
-  r.qs_w = sel(valid, q12w * q3w - q12z * q3z, T(1));
-  r.qs_x = sel(valid, q12x * q3w + q12y * q3z, T(0));
-  r.qs_y = sel(valid, q12y * q3w - q12x * q3z, T(0));
-  r.qs_z = sel(valid, q12z * q3w + q12w * q3z, T(0));
-  // Qe = cos(θ4/2) + sin(θ4/2) i: "+" where the extracted eq 14 prints "−" (readable note 3).
-  r.qe_w = sel(valid, ce, T(1));
-  r.qe_x = sel(valid, se, T(0));
-  r.ex = sel(valid, pex, T(0));
-  r.ey = sel(valid, pey, T(0));
-  r.ez = sel(valid, pez, c.d1);
+  const T d1 = c.d1;
+  if constexpr (kRare) {
+    r.qs_w = sel(valid, vw * k, T(1));
+    r.qs_x = sel(valid, vx * k, T(0));
+    r.qs_y = sel(valid, vy * k, T(0));
+    r.qs_z = sel(valid, vz * k, T(0));
+    // Qe = cos(θ4/2) + sin(θ4/2) i: "+" where the extracted eq 14 prints "−" (readable note 3).
+    r.qe_w = sel(valid, ce, T(1));
+    r.qe_x = sel(valid, se, T(0));
+    r.ex = sel(valid, d1 * ex, T(0));
+    r.ey = sel(valid, d1 * ey, T(0));
+    r.ez = sel(valid, d1 * ez, d1);
+  } else {
+    r.qs_w = vw * k, r.qs_x = vx * k, r.qs_y = vy * k, r.qs_z = vz * k;
+    r.qe_w = ce, r.qe_x = se;
+    r.ex = d1 * ex, r.ey = d1 * ey, r.ez = d1 * ez;
+  }
 
   // Status bits by arithmetic on the conditions (selects here are not if-converted).
   const T e_off_axis = ex * ex + ey * ey;
@@ -313,6 +422,28 @@ template <class T, bool kVector = true>
                  int(e_off_axis <= c.axis_tol2) * kBitElbowAxis + int(elbow_limit) * kBitElbowLimit;
   r.status = static_cast<std::uint8_t>(int(valid) * st + int(!valid) * kBitInvalid);
   return r;
+}
+
+/// The same from the swivel angle φ (|φ| ≤ kMaxSwivel, else kBitInvalid), by sincos() above.
+template <class T, Path kPath = Path::kVector>
+[[gnu::always_inline]] inline KernelResult<T> solve_kernel(const KernelConstants<T>& c, T px, T py,
+                                                           T pz, T phi) {
+  const bool ok = (phi <= T(1e4)) & (phi >= T(-1e4));  // false for NaN too
+  const SinCos<T> sc = sincos(sel(ok, phi, T(0)));
+  return solve_kernel_cs<T, kPath>(c, px, py, pz, sc.c, sc.s, ok);
+}
+
+/// The same from any positive multiple of (cos φ, sin φ); (0, 0) or non-finite: kBitInvalid.
+template <class T, Path kPath = Path::kVector>
+[[gnu::always_inline]] inline KernelResult<T> solve_kernel_dir(const KernelConstants<T>& c, T px,
+                                                               T py, T pz, T cphi, T sphi) {
+  const T q = cphi * cphi + sphi * sphi;
+  const bool ok = (q - q == T(0)) & (q >= std::numeric_limits<T>::min());
+  const T qq = sel(ok, q, T(1));
+  using Ops = std::conditional_t<kPath == Path::kVector, VectorOps<T>, ScalarOps<T>>;
+  const T inv = Ops::rsqrt(qq);
+  return solve_kernel_cs<T, kPath>(c, px, py, pz, sel(ok, cphi * inv, T(1)),
+                                   sel(ok, sphi * inv, T(0)), ok);
 }
 
 }  // namespace conform::ik::detail
