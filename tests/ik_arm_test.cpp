@@ -1,10 +1,12 @@
 // Arm IK (conform/ik/arm_ik.hpp): forward kinematics is the judge. The closed form (scalar and
 // batch, float and double), the readable algebra version, the explicit elbow branch, tracking
-// smoothness, the edge cases and the joint limits. Fixed seeds throughout.
+// smoothness, the edge cases and the joint limits; ArmSolver and the (cos φ, sin φ) swivel;
+// the previous Q12·Q3 kernel as a cross-check. Fixed seeds throughout.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -12,6 +14,7 @@
 #include "conform/cga/rounds_flats.hpp"
 #include "conform/ik/arm_ik.hpp"
 #include "conform/ik/kernel.hpp"
+#include "conform/ik/kernel_q12.hpp"
 
 namespace ik = conform::ik;
 namespace cga = conform::cga;
@@ -86,6 +89,13 @@ double rotation_angle(const Quatd& a, const Quatd& b) {
   return 2 * std::acos(d);
 }
 
+// The same, accurate for small angles too (acos near 1 is not): θ = 4 asin(|a ∓ b|/2).
+double rotation_distance(const Quatd& a, const Quatd& b) {
+  const Eigen::Vector4d x = a.normalized().coeffs(), y = b.normalized().coeffs();
+  const double d = std::min((x - y).norm(), (x + y).norm());
+  return 4 * std::asin(std::min(1.0, d / 2));
+}
+
 bool finite(const ik::Solution<double>& s) {
   return s.qs.coeffs().allFinite() && s.qe.coeffs().allFinite() && s.elbow.allFinite();
 }
@@ -138,12 +148,18 @@ TEST(IkKernel, SinCosAndRsqrtAreAccurate) {
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> wide(-1e4, 1e4), narrow(-4, 4);
   double worst_d = 0, worst_f = 0, worst_rs_d = 0, worst_rs_f = 0;
+  int table_mismatch = 0;
   for (int i = 0; i < 200000; ++i) {
     const double x = (i % 2) ? wide(rng) : narrow(rng);
     const auto d = ik::detail::sincos(x);
+    // The scalar path's quadrant table gives the very same numbers as the selects.
+    const auto ds = ik::detail::sincos_scalar(x);
+    if (ds.s != d.s || ds.c != d.c) ++table_mismatch;
     worst_d = std::max({worst_d, std::abs(d.s - std::sin(x)), std::abs(d.c - std::cos(x))});
     const float xf = static_cast<float>(x);
     const auto f = ik::detail::sincos(xf);
+    const auto fs = ik::detail::sincos_scalar(xf);
+    if (fs.s != f.s || fs.c != f.c) ++table_mismatch;
     // Reference in double at the float argument: only the float arithmetic is measured.
     worst_f = std::max(
         {worst_f, std::abs(f.s - std::sin(double(xf))), std::abs(f.c - std::cos(double(xf)))});
@@ -157,8 +173,165 @@ TEST(IkKernel, SinCosAndRsqrtAreAccurate) {
   EXPECT_LT(worst_f, 4e-7);
   EXPECT_LT(worst_rs_d, 5e-16);
   EXPECT_LT(worst_rs_f, 3e-7);
+  EXPECT_EQ(table_mismatch, 0);
   EXPECT_EQ(ik::detail::sqrt(0.0), 0.0);
   EXPECT_EQ(ik::detail::sqrt(0.0f), 0.0f);
+}
+
+namespace {
+
+// Targets for the cross-checks below: random ones inside and outside the shell, and the edge
+// cases (shoulder, z axis, near the axis, full extension and fold) with assorted swivels.
+Targets<double> mixed_targets(std::size_t n, double d1, double d2, unsigned seed) {
+  Targets<double> t = random_targets<double>(n, d1, d2, seed);
+  std::mt19937_64 rng(seed + 1);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (std::size_t i = 0; i < n; i += 3) {  // every third one anywhere in [0, 1.4 (d1 + d2)]
+    const double len = std::sqrt(t.x[i] * t.x[i] + t.y[i] * t.y[i] + t.z[i] * t.z[i]);
+    const double f = 1.4 * (d1 + d2) * u(rng) / len;
+    t.x[i] *= f, t.y[i] *= f, t.z[i] *= f;
+  }
+  const double s = d1 + d2;
+  const std::vector<Vec3d> edges = {
+      Vec3d(0, 0, 0),           Vec3d(0, 0, 0.7 * s),     Vec3d(0, 0, -0.7 * s),
+      Vec3d(0, 0, 2 * s),       Vec3d(1e-13, 0, 0.5 * s), Vec3d(0, 1e-9, -0.5 * s),
+      Vec3d(0.3, 0.4, 0) * s,   Vec3d(0.6, 0, 0.8) * s,   Vec3d(0.01, 0.02, 0.0) * s,
+      Vec3d(-0.2, 0.1, 0.9) * s};
+  for (const Vec3d& e : edges)
+    for (double phi : {0.0, 1.0, -2.5, kPi, -kPi / 2}) {
+      t.x.push_back(e.x()), t.y.push_back(e.y()), t.z.push_back(e.z()), t.phi.push_back(phi);
+    }
+  return t;
+}
+
+}  // namespace
+
+// ArmSolver is solve(arm, …) with the constants kept: the same numbers, bit for bit, for every
+// kind of arm and target. The (cos φ, sin φ) overload agrees with the angle (its pair comes
+// from std::cos/std::sin, the angle's from the kernel's polynomial: rounding apart) and accepts
+// any positive multiple of the pair.
+TEST(IkSolver, MatchesFreeSolveAndCosSinOverload) {
+  std::vector<ik::Arm<double>> arms(4);
+  arms[1].limits.elbow_min = 0.3, arms[1].limits.elbow_max = 2.0;
+  arms[2].upper = 0.2, arms[2].fore = 0.45;
+  arms[3].limits.cone_axis = Vec3d(0, 0, 1), arms[3].limits.cone_half_angle = 1.2;
+  for (std::size_t a = 0; a < arms.size(); ++a) {
+    const ik::Arm<double>& arm = arms[a];
+    const ik::ArmSolver<double> solver(arm);
+    ASSERT_TRUE(solver.valid());
+    const double scale = arm.upper + arm.fore;
+    const auto t = mixed_targets(3000, arm.upper, arm.fore, 600 + unsigned(a));
+    double worst_q = 0, worst_elbow = 0;
+    std::size_t status_differs = 0;
+    for (std::size_t i = 0; i < t.x.size(); ++i) {
+      const Vec3d p(t.x[i], t.y[i], t.z[i]);
+      const auto free_sol = ik::solve(arm, p, t.phi[i]);
+      const auto s = solver.solve(p, t.phi[i]);
+      ASSERT_EQ(s.qs.coeffs(), free_sol.qs.coeffs()) << a << " " << i;
+      ASSERT_EQ(s.qe.coeffs(), free_sol.qe.coeffs()) << a << " " << i;
+      ASSERT_EQ(s.elbow, free_sol.elbow) << a << " " << i;
+      ASSERT_EQ(s.status, free_sol.status) << a << " " << i;
+      const double c = std::cos(t.phi[i]), sn = std::sin(t.phi[i]);
+      for (const auto& cs : {solver.solve(p, ik::SwivelCosSin<double>{c, sn}),
+                             ik::solve(arm, p, ik::SwivelCosSin<double>{2.5 * c, 2.5 * sn})}) {
+        ASSERT_TRUE(finite(cs));
+        worst_q =
+            std::max({worst_q, rotation_distance(cs.qs, s.qs), rotation_distance(cs.qe, s.qe)});
+        worst_elbow = std::max(worst_elbow, (cs.elbow - s.elbow).norm());
+        // Flags decided at a threshold (elbow or target on the axis) may flip by rounding.
+        if (cs.status != s.status) ++status_differs;
+      }
+    }
+    EXPECT_LE(worst_q, 1e-12) << a;
+    EXPECT_LE(worst_elbow, 1e-13 * scale) << a;
+    EXPECT_LE(status_differs, 2u) << a;
+  }
+  // Invalid pairs and arms.
+  const ik::ArmSolver<double> solver;
+  for (const auto& cs : {ik::SwivelCosSin<double>{0, 0}, ik::SwivelCosSin<double>{std::nan(""), 1},
+                         ik::SwivelCosSin<double>{INFINITY, 0}}) {
+    const auto s = solver.solve(Vec3d(0.1, 0.2, 0.3), cs);
+    EXPECT_EQ(s.status, ik::Status::kInvalidInput);
+    EXPECT_TRUE(finite(s));
+    EXPECT_TRUE(s.qs.isApprox(Quatd::Identity()));
+  }
+  EXPECT_EQ(solver.solve(Vec3d(0.1, std::nan(""), 0.3), 0.2).status, ik::Status::kInvalidInput);
+  EXPECT_EQ(solver.solve(Vec3d(0.1, 0.2, 0.3), 2e4).status, ik::Status::kInvalidInput);
+  const ik::ArmSolver<double> bad(ik::Arm<double>{0.3, -0.1, {}});
+  EXPECT_FALSE(bad.valid());
+  EXPECT_EQ(bad.solve(Vec3d(0.1, 0.2, 0.3), 0.2).status, ik::Status::kInvalidInput);
+  EXPECT_EQ(bad.solve(Vec3d(0.1, 0.2, 0.3), ik::SwivelCosSin<double>{}).status,
+            ik::Status::kInvalidInput);
+}
+
+// The three paths of the kernel: the scalar common-case one (rare cases' selects left out)
+// gives the very numbers of the scalar all-cases one, and the vector one (Newton roots) agrees
+// to rounding; the previous formulation (Q12·Q3, kernel_q12.hpp) gives the same rotation and
+// elbow. Qs has w ≥ 0.
+template <class T>
+void check_kernel_paths(double tol_q, double tol_len) {
+  namespace d = ik::detail;
+  for (const auto& [d1, d2] : {std::pair{0.3, 0.25}, std::pair{0.2, 0.45}, std::pair{0.4, 0.4}}) {
+    for (const double flex_min : {0.0, 0.25}) {
+      const auto c = d::KernelConstants<T>::make(d1, d2, flex_min, 2.6);
+      const auto c12 = d::q12::KernelConstants<T>::make(d1, d2, flex_min, 2.6);
+      const auto t = mixed_targets(4000, d1, d2, 77);
+      double worst_q = 0, worst_len = 0, worst_vec = 0;
+      std::size_t common = 0, status_differs = 0, negative_w = 0;
+      for (std::size_t i = 0; i < t.x.size(); ++i) {
+        const T x = T(t.x[i]), y = T(t.y[i]), z = T(t.z[i]), phi = T(t.phi[i]);
+        const auto all = d::solve_kernel<T, d::Path::kScalar>(c, x, y, z, phi);
+        const auto vec = d::solve_kernel<T, d::Path::kVector>(c, x, y, z, phi);
+        const auto old = d::q12::solve_kernel<T, false>(c12, x, y, z, phi);
+        if (all.qs_w < T(0)) ++negative_w;
+        const T r2 = x * x + y * y + z * z;
+        if (r2 > c.tiny2 && x * x + y * y > c.axis_tol2 * r2) {
+          ++common;
+          const auto sc = d::sincos_scalar(phi);
+          const auto fast = d::solve_kernel_cs<T, d::Path::kCommon>(c, x, y, z, sc.c, sc.s, true);
+          ASSERT_EQ(fast.qs_w, all.qs_w) << i;
+          ASSERT_EQ(fast.qs_x, all.qs_x) << i;
+          ASSERT_EQ(fast.qs_y, all.qs_y) << i;
+          ASSERT_EQ(fast.qs_z, all.qs_z) << i;
+          ASSERT_EQ(fast.qe_w, all.qe_w) << i;
+          ASSERT_EQ(fast.qe_x, all.qe_x) << i;
+          ASSERT_EQ(fast.ex, all.ex) << i;
+          ASSERT_EQ(fast.ez, all.ez) << i;
+          ASSERT_EQ(fast.status, all.status) << i;
+        }
+        // Within rounding of the shell the flexion is √ε-sensitive to |Pw| (the formulations
+        // round |Pw| differently): only the bitwise check above there.
+        const double len = std::sqrt(double(x) * x + double(y) * y + double(z) * z);
+        const double eps = std::numeric_limits<T>::epsilon();
+        if (std::abs(len - (d1 + d2)) < 1e3 * eps * (d1 + d2) ||
+            std::abs(len - std::abs(d1 - d2)) < 1e3 * eps * (d1 + d2))
+          continue;
+        const Quatd qa(all.qs_w, all.qs_x, all.qs_y, all.qs_z),
+            qv(vec.qs_w, vec.qs_x, vec.qs_y, vec.qs_z), qo(old.qs_w, old.qs_x, old.qs_y, old.qs_z);
+        worst_vec = std::max({worst_vec, (qa.coeffs() - qv.coeffs()).norm(),
+                              std::abs(double(all.qe_x) - double(vec.qe_x))});
+        worst_q = std::max({worst_q, rotation_distance(qa, qo),
+                            std::abs(double(all.qe_w) - double(old.qe_w)),
+                            std::abs(double(all.qe_x) - double(old.qe_x))});
+        worst_len = std::max({worst_len, std::abs(double(all.ex) - double(old.ex)),
+                              std::abs(double(all.ey) - double(old.ey)),
+                              std::abs(double(all.ez) - double(old.ez))});
+        // Threshold flags (elbow on the axis, clamps at the shell) may flip by rounding.
+        if (all.status != old.status || all.status != vec.status) ++status_differs;
+      }
+      EXPECT_GT(common, t.x.size() / 2);
+      EXPECT_EQ(negative_w, 0u);
+      EXPECT_LE(worst_q, tol_q) << d1 << " " << d2 << " " << flex_min;
+      EXPECT_LE(worst_vec, tol_q) << d1 << " " << d2 << " " << flex_min;
+      EXPECT_LE(worst_len, tol_len * (d1 + d2)) << d1 << " " << d2 << " " << flex_min;
+      EXPECT_LE(status_differs, 4u) << d1 << " " << d2 << " " << flex_min;
+    }
+  }
+}
+
+TEST(IkKernel, PathsAgreeAndMatchTheQ12Form) {
+  check_kernel_paths<double>(1e-12, 1e-14);
+  check_kernel_paths<float>(2e-5, 4e-6);
 }
 
 // The algebra helpers the readable solver relies on (not covered elsewhere).

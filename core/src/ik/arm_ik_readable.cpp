@@ -20,15 +20,18 @@
 //  4. Eq 15: Q12 = (pex(d1−pez), pey(d1−pez), pex²+pey²)/|Lm| = (d1 − pez)(Pe + d1ẑ)/|Lm|:
 //     right, but 0/0 when the elbow is at +d1ẑ, and ill-conditioned near −d1ẑ. Here (as in the
 //     paper) Lm = πe ∧ πm, with an explicit fallback on the z axis (k at +z, i at −z); the
-//     closed form drops the factor (d1 − pez) and switches to the bisector of Pe and −d1ẑ
-//     composed with i below the xy plane.
+//     previous closed form (kernel_q12.hpp) drops the factor (d1 − pez) and switches to the
+//     bisector of Pe and −d1ẑ composed with i below the xy plane. The closed form (kernel.hpp)
+//     has no Q12: it takes Qs from the upper arm's frame (−n̂, ŷ', ê) at once, which eqs 15–18
+//     describe as a product (Qs·x̂ = −n̂ and Qs·ẑ = ê fix the rotation).
 //  5. Eq 17: c3 = −(Q12 e1 Q̃12)·n̂ as printed, i.e. the hinge axis is Qs·x̂ = −n̂ (consistent
 //     with 3). The printed sign test sign(πyz2·Pw) is right whenever the elbow is bent
 //     (πyz2·Pw = d2 sin θ3 sin θ4) but is 0/0 at full extension; we take the sign of
 //     s3 = −(Q12 e2 Q̃12)·n̂ = sin θ3 instead, defined everywhere.
 //  6. Eq 16/9: √((1−c)/2) loses half the digits for small angles (float: 2e-4 rad); this file
-//     keeps the paper's half-angle formulas, the closed form uses t = √((1+|c|)/2), u = s/(2t).
-//  7. Eq 18 is right as printed (Qs = Q12 Q3 with q12's scalar 0); the closed form adds the
+//     keeps the paper's half-angle formulas; the closed form has no 1 − c: eq 14's half-angles
+//     come from the triangle factors, Qs from Shepperd's method with the largest pivot.
+//  7. Eq 18 is right as printed (Qs = Q12 Q3 with q12's scalar 0); kernel_q12.hpp adds the
 //     scalar term for its lower-hemisphere Q12.
 // Quaternions map to rotors by i = e3∧e2, j = e1∧e3, k = e2∧e1: q = w + xi + yj + zk is the
 // rotor w − x e23 + y e13 − z e12, and X' = R X R̃ is v' = q v q*.
