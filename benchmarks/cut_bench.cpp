@@ -1,27 +1,40 @@
-// Cut, tear and drill on the procedural arm at the paper's size (5,120 faces; the paper's arm
-// has 5,037) and at 50k, 500k and 2M faces, with the paper's Python timings beside ours as
-// `speedup` counters (paper time / our time): cut 4666 ms, tear 2437 ms, drill 274 ms.
+// The cut (Algorithm 1) on the procedural arm at the paper's size (5,120 faces; the paper's arm
+// has 5,037) and at 50k, 500k and 2M faces, with and without caps, with the paper's Python
+// timing beside ours as `speedup` counters (paper time / our time): cut 4666 ms. (The tear and
+// drill benchmarks are in tear_drill_bench.cpp.)
+//
 // Table 1 is reproduced by the Table1_* benchmarks: the cut's four subroutines, with the
-// conformal (X·Π) and the Euclidean (n·x − d) predicates, in the same run.
+// conformal (X·Π) and the Euclidean (n·x − d) predicates, in the same run, the paper's figures
+// beside ours as counters.
+//
+// When CMake found CGAL (libcgal-dev), BM_CgalClip times CGAL's
+// Polygon_mesh_processing::clip of the same mesh (as a Surface_mesh, built outside the timing)
+// by the same plane, with clip_volume = cap; the run ends with the ratios CGAL / ours of the
+// median times. CGAL's clip keeps one side; our cut keeps both and labels the pieces.
 //
 // Every benchmark times only the operation (manual time, in thread CPU time): restoring the
-// mesh is not timed. The tear and drill benchmarks run a fixed number of iterations, since
-// their untimed set-up (copying a mesh of up to 2M faces) would otherwise dominate the run. Run
-// with
-// --benchmark_repetitions=5 --benchmark_report_aggregates_only=true for medians. CGAL's
-// Polygon_mesh_processing::clip is not compared: libcgal-dev is not installed.
+// mesh is not timed. Iteration counts are fixed at 500k and 2M faces, where the untimed set-up
+// (copying the mesh) would otherwise dominate the run. Run with
+//   --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+// for medians.
 #include <benchmark/benchmark.h>
 
 #include <time.h>
 
 #include <cmath>
+#include <cstdio>
 #include <map>
+#include <string>
 
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/cut.hpp"
-#include "conform/mesh/drill.hpp"
 #include "conform/mesh/procedural_arm.hpp"
-#include "conform/mesh/tear.hpp"
+
+#if CONFORM_HAVE_CGAL
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/clip.h>
+#include <CGAL/Surface_mesh.h>
+#endif
 
 using namespace conform::mesh;
 using Plane = conform::cga::Plane<double>;
@@ -29,12 +42,12 @@ using Plane = conform::cga::Plane<double>;
 namespace {
 
 constexpr double kPaperCutSeconds = 4.666645036;
-constexpr double kPaperTearSeconds = 2.437;
-constexpr double kPaperDrillSeconds = 0.274;
 // Table 1 (GA column / Euclidean column), seconds.
 constexpr double kPaperSub1Ga = 0.072434584, kPaperSub1Eu = 0.036439578;
 constexpr double kPaperSub2Ga = 2.205727577, kPaperSub2Eu = 2.050984303;
 constexpr double kPaperSub3 = 0.061544961, kPaperSub4 = 2.326937914;
+
+constexpr int kSizes[] = {0, 50000, 500000, 2000000};
 
 // Arm sizes: 0 → the default arm (5,120 faces); else about that many faces.
 struct Model {
@@ -83,32 +96,33 @@ void speedup(benchmark::State& state, double paper_seconds, double total_seconds
 }
 
 // A plane across the forearm, slightly oblique (as the paper's Fig. 3 cut).
-const Plane kCutPlane = Plane::from_normal_point({0.15, 0.1, 1.0}, {0.0, 0.0, 0.42});
+const Eigen::Vector3d kCutNormal{0.15, 0.1, 1.0}, kCutPoint{0.0, 0.0, 0.42};
+const Plane kCutPlane = Plane::from_normal_point(kCutNormal, kCutPoint);
 
-void BM_Cut(benchmark::State& state) {
-  const Model& m = model(static_cast<int>(state.range(0)));
-  const CutOptions options{.cap = state.range(1) != 0};
-  std::int32_t pieces = 0;
+// The whole operation: compute the change, apply it (keeping the adjacency), label pieces.
+void cut_bench(benchmark::State& state, int faces, bool cap) {
+  const Model& m = model(faces);
+  const CutOptions options{.cap = cap};
+  std::int32_t pieces = 0, capped = 0;
   double total = 0;
   for (auto _ : state) {
     SkinnedMesh mesh = m.mesh;
     Adjacency adjacency = m.adjacency;
-    total += timed(state, [&] { pieces = cut(mesh, adjacency, kCutPlane, options).pieces.count; });
+    total += timed(state, [&] {
+      const CutOutcome out = cut(mesh, adjacency, kCutPlane, options);
+      pieces = out.pieces.count, capped = out.result.capped_loops;
+    });
     benchmark::DoNotOptimize(pieces);
   }
   state.counters["faces"] = static_cast<double>(m.mesh.face_count());
   state.counters["pieces"] = pieces;
+  if (cap) state.counters["capped_loops"] = capped;
   speedup(state, kPaperCutSeconds, total);
 }
-BENCHMARK(BM_Cut)
-    ->ArgsProduct({{0, 50000, 500000, 2000000}, {0, 1}})
-    ->ArgNames({"faces", "cap"})
-    ->UseManualTime()
-    ->Unit(benchmark::kMillisecond);
 
 // The change alone (no mutation): classification, snapping, intersections, re-triangulation.
-void BM_CutComputeOnly(benchmark::State& state) {
-  const Model& m = model(static_cast<int>(state.range(0)));
+void compute_bench(benchmark::State& state, int faces) {
+  const Model& m = model(faces);
   double total = 0;
   for (auto _ : state) {
     total += timed(state, [&] {
@@ -119,19 +133,55 @@ void BM_CutComputeOnly(benchmark::State& state) {
   state.counters["faces"] = static_cast<double>(m.mesh.face_count());
   speedup(state, kPaperCutSeconds, total);
 }
-BENCHMARK(BM_CutComputeOnly)
-    ->Arg(0)
-    ->Arg(50000)
-    ->Arg(500000)
-    ->Arg(2000000)
-    ->ArgName("faces")
-    ->UseManualTime()
-    ->Unit(benchmark::kMillisecond);
+
+#if CONFORM_HAVE_CGAL
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using CgalMesh = CGAL::Surface_mesh<Kernel::Point_3>;
+
+const CgalMesh& cgal_model(int faces) {
+  static std::map<int, CgalMesh> cache;
+  auto it = cache.find(faces);
+  if (it != cache.end()) return it->second;
+  const SkinnedMesh& m = model(faces).mesh;
+  CgalMesh s;
+  std::vector<CgalMesh::Vertex_index> v;
+  v.reserve(static_cast<std::size_t>(m.vertex_count()));
+  for (Eigen::Index i = 0; i < m.current.cols(); ++i)
+    v.push_back(s.add_vertex(Kernel::Point_3(m.current(0, i), m.current(1, i), m.current(2, i))));
+  for (const Face& f : m.faces)
+    s.add_face(v[static_cast<std::size_t>(f[0])], v[static_cast<std::size_t>(f[1])],
+               v[static_cast<std::size_t>(f[2])]);
+  return cache.emplace(faces, std::move(s)).first->second;
+}
+
+// CGAL's clip by the same plane (n·x − n·p = 0), keeping its negative side.
+void cgal_clip_bench(benchmark::State& state, int faces, bool cap) {
+  const CgalMesh& base = cgal_model(faces);
+  const Eigen::Vector3d n = kCutNormal.normalized();
+  const Kernel::Plane_3 plane(n.x(), n.y(), n.z(), -n.dot(kCutPoint));
+  std::size_t kept = 0;
+  bool closed = false;
+  double total = 0;
+  for (auto _ : state) {
+    CgalMesh mesh = base;
+    total += timed(state, [&] {
+      CGAL::Polygon_mesh_processing::clip(
+          mesh, plane, CGAL::Polygon_mesh_processing::parameters::clip_volume(cap));
+    });
+    kept = mesh.number_of_faces();
+    closed = CGAL::is_closed(mesh);
+  }
+  state.counters["faces"] = static_cast<double>(base.number_of_faces());
+  state.counters["kept_faces"] = static_cast<double>(kept);
+  state.counters["closed"] = closed;
+  speedup(state, kPaperCutSeconds, total);
+}
+#endif
 
 // Table 1, subroutine 1: vertex classification.
-void BM_Table1_Sub1_Classify(benchmark::State& state) {
+void table1_sub1(benchmark::State& state, bool euclidean) {
   const Model& m = model(0);
-  const auto p = state.range(0) == 0 ? Predicates::Cga : Predicates::Euclidean;
+  const auto p = euclidean ? Predicates::Euclidean : Predicates::Cga;
   std::vector<double> d;
   double total = 0;
   for (auto _ : state) {
@@ -140,21 +190,15 @@ void BM_Table1_Sub1_Classify(benchmark::State& state) {
       benchmark::DoNotOptimize(d.data());
     });
   }
-  state.SetLabel(p == Predicates::Cga ? "CGA X.Pi" : "Euclidean n.x-d");
-  speedup(state, p == Predicates::Cga ? kPaperSub1Ga : kPaperSub1Eu, total);
+  state.SetLabel(euclidean ? "Euclidean n.x-d" : "CGA X.Pi");
+  speedup(state, euclidean ? kPaperSub1Eu : kPaperSub1Ga, total);
 }
-BENCHMARK(BM_Table1_Sub1_Classify)
-    ->Arg(0)
-    ->Arg(1)
-    ->ArgName("euclidean")
-    ->UseManualTime()
-    ->Unit(benchmark::kMicrosecond);
 
-// Subroutine 2: intersections and re-triangulation (compute_cut minus the classification it
-// also does, which the Sub1 row measures separately; here timed whole).
-void BM_Table1_Sub2_IntersectTriangulate(benchmark::State& state) {
+// Subroutine 2: intersections and re-triangulation (compute_cut, which also classifies: the
+// Sub1 row measures that part separately).
+void table1_sub2(benchmark::State& state, bool euclidean) {
   const Model& m = model(0);
-  const CutOptions o{.predicates = state.range(0) == 0 ? Predicates::Cga : Predicates::Euclidean};
+  const CutOptions o{.predicates = euclidean ? Predicates::Euclidean : Predicates::Cga};
   double total = 0;
   for (auto _ : state) {
     total += timed(state, [&] {
@@ -162,18 +206,12 @@ void BM_Table1_Sub2_IntersectTriangulate(benchmark::State& state) {
       benchmark::DoNotOptimize(r.change.added_faces.data());
     });
   }
-  state.SetLabel(std::string(state.range(0) == 0 ? "CGA" : "Euclidean") + ", includes sub 1");
-  speedup(state, state.range(0) == 0 ? kPaperSub2Ga : kPaperSub2Eu, total);
+  state.SetLabel(std::string(euclidean ? "Euclidean" : "CGA") + ", includes sub 1");
+  speedup(state, euclidean ? kPaperSub2Eu : kPaperSub2Ga, total);
 }
-BENCHMARK(BM_Table1_Sub2_IntersectTriangulate)
-    ->Arg(0)
-    ->Arg(1)
-    ->ArgName("euclidean")
-    ->UseManualTime()
-    ->Unit(benchmark::kMicrosecond);
 
 // Subroutine 3: weights (and the other attributes) of the new vertices.
-void BM_Table1_Sub3_Weights(benchmark::State& state) {
+void table1_sub3(benchmark::State& state) {
   const Model& m = model(0);
   const CutResult r = compute_cut(m.mesh, kCutPlane);
   double total = 0;
@@ -185,10 +223,9 @@ void BM_Table1_Sub3_Weights(benchmark::State& state) {
   state.counters["new_vertices"] = static_cast<double>(r.change.new_vertices.size());
   speedup(state, kPaperSub3, total);
 }
-BENCHMARK(BM_Table1_Sub3_Weights)->UseManualTime()->Unit(benchmark::kMicrosecond);
 
 // Subroutine 4: split into pieces (apply the faces, keep the adjacency, label components).
-void BM_Table1_Sub4_Split(benchmark::State& state) {
+void table1_sub4(benchmark::State& state) {
   const Model& m = model(0);
   const CutResult r = compute_cut(m.mesh, kCutPlane);
   SkinnedMesh with_vertices = m.mesh;
@@ -205,94 +242,97 @@ void BM_Table1_Sub4_Split(benchmark::State& state) {
   }
   speedup(state, kPaperSub4, total);
 }
-BENCHMARK(BM_Table1_Sub4_Split)->UseManualTime()->Unit(benchmark::kMicrosecond);
 
-ScalpelSample arm_blade(int i, int n) {
-  const double z = 0.08 + 0.2 * i / (n - 1.0), a = 0.3 + 0.4 * i / (n - 1.0);
-  return {double(i), {0, 0, z}, {0.2 * std::cos(a), 0.2 * std::sin(a), z}};
-}
-
-// One tear step (sample 50 of a 100-sample stroke, after 49 steps).
-void BM_TearStep(benchmark::State& state) {
-  const Model& m = model(static_cast<int>(state.range(0)));
-  int grew = 0;
-  double total = 0;
-  for (auto _ : state) {
-    SkinnedMesh mesh = m.mesh;
-    Adjacency adjacency = m.adjacency;
-    Tear tear(mesh, adjacency);
-    for (int i = 0; i < 50; ++i) tear.advance(arm_blade(i, 100));
-    total += timed(state, [&] { grew += tear.advance(arm_blade(50, 100)).extended; });
+// Ratios of median manual times, measured in the same run.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const auto& run : runs) {
+      std::string name = run.run_name.str();
+      if (const auto at = name.find("/manual_time"); at != std::string::npos) name.erase(at);
+      const double t = run.GetAdjustedRealTime();
+      if (run.run_type == Run::RT_Aggregate) {
+        if (run.aggregate_name == "median") median_[name] = t;
+      } else if (!median_.count(name) || single_.count(name)) {
+        single_[name] = t;
+        median_[name] = t;
+      }
+    }
   }
-  state.counters["extended"] = grew == static_cast<int>(state.iterations());
-  state.counters["faces"] = static_cast<double>(m.mesh.face_count());
-  speedup(state, kPaperTearSeconds, total);
-}
-BENCHMARK(BM_TearStep)
-    ->Arg(0)
-    ->Arg(50000)
-    ->Arg(500000)
-    ->Arg(2000000)
-    ->ArgName("faces")
-    ->UseManualTime()
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(30);
-
-// A whole 100-sample stroke (the first sample scans the faces once to start).
-void BM_Tear100(benchmark::State& state) {
-  const Model& m = model(static_cast<int>(state.range(0)));
-  int steps = 0;
-  double total = 0;
-  for (auto _ : state) {
-    SkinnedMesh mesh = m.mesh;
-    Adjacency adjacency = m.adjacency;
-    total += timed(state, [&] {
-      Tear tear(mesh, adjacency);
-      for (int i = 0; i < 100; ++i) tear.advance(arm_blade(i, 100));
-      steps = tear.steps();
-    });
+  void Finalize() override {
+    ConsoleReporter::Finalize();
+    std::printf("\nRatios of median times (same run):\n");
+    auto ratio = [&](const std::string& a, const std::string& b, const char* what) {
+      const auto ia = median_.find(a), ib = median_.find(b);
+      if (ia != median_.end() && ib != median_.end())
+        std::printf("  %-44s / %-40s %8.3f  %s\n", a.c_str(), b.c_str(), ia->second / ib->second,
+                    what);
+    };
+    for (int faces : kSizes)
+      for (int cap = 0; cap < 2; ++cap) {
+        const std::string tail = "/faces:" + std::to_string(faces) + "/cap:" + std::to_string(cap);
+        ratio("BM_CgalClip" + tail, "BM_Cut" + tail, "(> 1: our cut is faster than CGAL's clip)");
+      }
+    ratio("BM_Table1_Sub1_Classify/euclidean:0", "BM_Table1_Sub1_Classify/euclidean:1",
+          "(CGA / Euclidean predicates)");
+    ratio("BM_Table1_Sub2_IntersectTriangulate/euclidean:0",
+          "BM_Table1_Sub2_IntersectTriangulate/euclidean:1", "(CGA / Euclidean predicates)");
+    std::fflush(stdout);
   }
-  state.counters["steps"] = steps;
-  state.counters["faces"] = static_cast<double>(m.mesh.face_count());
-  speedup(state, kPaperTearSeconds, total);
-}
-BENCHMARK(BM_Tear100)
-    ->Arg(0)
-    ->Arg(50000)
-    ->Arg(500000)
-    ->Arg(2000000)
-    ->ArgName("faces")
-    ->UseManualTime()
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(10);
 
-// Drill through the forearm (both walls), radius 1 cm.
-void BM_Drill(benchmark::State& state) {
-  const Model& m = model(static_cast<int>(state.range(0)));
-  const DrillTool tool{{0, -0.2, 0.42}, {0, 0.2, 0.42}, 0.01};
-  DrillResult r;
-  double total = 0;
-  for (auto _ : state) {
-    SkinnedMesh mesh = m.mesh;
-    Adjacency adjacency = m.adjacency;
-    total += timed(state, [&] { r = drill(mesh, adjacency, tool); });
+ private:
+  std::map<std::string, double> median_, single_;
+};
+
+void register_all() {
+  for (int faces : kSizes) {
+    const int iterations = faces >= 2000000 ? 3 : faces >= 500000 ? 10 : 0;  // 0: automatic
+    const std::string size = "/faces:" + std::to_string(faces);
+    auto fixed = [&](benchmark::internal::Benchmark* b) {
+      b->UseManualTime()->Unit(benchmark::kMillisecond);
+      if (iterations > 0) b->Iterations(iterations);
+    };
+    for (int cap = 0; cap < 2; ++cap) {
+      const std::string tail = size + "/cap:" + std::to_string(cap);
+      fixed(benchmark::RegisterBenchmark(("BM_Cut" + tail).c_str(),
+                                         [=](benchmark::State& s) { cut_bench(s, faces, cap); }));
+#if CONFORM_HAVE_CGAL
+      fixed(benchmark::RegisterBenchmark(("BM_CgalClip" + tail).c_str(), [=](benchmark::State& s) {
+        cgal_clip_bench(s, faces, cap);
+      }));
+#endif
+    }
+    fixed(benchmark::RegisterBenchmark(("BM_CutComputeOnly" + size).c_str(),
+                                       [=](benchmark::State& s) { compute_bench(s, faces); }));
   }
-  state.counters["holes"] = r.holes;
-  state.counters["rim_points"] = r.rim_vertices;
-  state.counters["refinements"] = r.refinements;
-  state.counters["faces"] = static_cast<double>(m.mesh.face_count());
-  speedup(state, kPaperDrillSeconds, total);
+  for (int e = 0; e < 2; ++e) {
+    const std::string arg = "/euclidean:" + std::to_string(e);
+    benchmark::RegisterBenchmark(("BM_Table1_Sub1_Classify" + arg).c_str(),
+                                 [=](benchmark::State& s) { table1_sub1(s, e); })
+        ->UseManualTime()
+        ->Unit(benchmark::kMicrosecond);
+    benchmark::RegisterBenchmark(("BM_Table1_Sub2_IntersectTriangulate" + arg).c_str(),
+                                 [=](benchmark::State& s) { table1_sub2(s, e); })
+        ->UseManualTime()
+        ->Unit(benchmark::kMicrosecond);
+  }
+  benchmark::RegisterBenchmark("BM_Table1_Sub3_Weights", table1_sub3)
+      ->UseManualTime()
+      ->Unit(benchmark::kMicrosecond);
+  benchmark::RegisterBenchmark("BM_Table1_Sub4_Split", table1_sub4)
+      ->UseManualTime()
+      ->Unit(benchmark::kMicrosecond);
 }
-BENCHMARK(BM_Drill)
-    ->Arg(0)
-    ->Arg(50000)
-    ->Arg(500000)
-    ->Arg(2000000)
-    ->ArgName("faces")
-    ->UseManualTime()
-    ->Unit(benchmark::kMillisecond)
-    ->Iterations(20);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  register_all();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  benchmark::Shutdown();
+  return 0;
+}

@@ -3,22 +3,17 @@
 namespace conform::mesh {
 
 void EdgeMap::clear() {
-  keys_.clear();
-  values_.clear();
+  slots_.clear();
   size_ = used_ = 0;
 }
 
 void EdgeMap::rehash(std::size_t capacity) {
-  std::vector<std::uint64_t> old_keys = std::move(keys_);
-  std::vector<std::int32_t> old_values = std::move(values_);
-  keys_.assign(capacity, kEmpty);
-  values_.assign(capacity, kNone);
+  std::vector<Slot> old = std::move(slots_);
+  slots_.assign(capacity, Slot{kEmpty, kNone});
   size_ = used_ = 0;
-  for (std::size_t i = 0; i < old_keys.size(); ++i)
-    if (old_keys[i] != kEmpty && old_keys[i] != kTomb) {
-      const std::size_t s = slot(old_keys[i]);
-      keys_[s] = old_keys[i];
-      values_[s] = old_values[i];
+  for (const Slot& o : old)
+    if (o.key != kEmpty && o.key != kTomb) {
+      slots_[slot(o.key)] = o;
       ++size_, ++used_;
     }
 }
@@ -26,61 +21,63 @@ void EdgeMap::rehash(std::size_t capacity) {
 void EdgeMap::reserve(std::size_t count) {
   std::size_t cap = 16;
   while (cap < 2 * count) cap *= 2;
-  if (cap > keys_.size()) rehash(cap);
+  if (cap > slots_.size()) rehash(cap);
 }
 
 void EdgeMap::grow() {
   // Double when live entries fill half the table, else only drop the tombstones.
-  if (keys_.empty()) return rehash(16);
-  rehash(2 * size_ + 2 > keys_.size() / 2 ? 2 * keys_.size() : keys_.size());
+  if (slots_.empty()) return rehash(16);
+  rehash(2 * size_ + 2 > slots_.size() / 2 ? 2 * slots_.size() : slots_.size());
 }
 
+// Home slots take bits 32 and up of the multiplicative hash: they depend on both vertices of
+// the key (bits below 32 would see only the second one, so that keys sharing it — (v, 0) in
+// the cut's loop maps, or a vertex's fan here — would pile up in one probe run).
+//
 // The slot holding k, or the first empty slot of its probe sequence.
 std::size_t EdgeMap::slot(std::uint64_t k) const {
-  const std::size_t mask = keys_.size() - 1;
-  std::size_t s = std::size_t(k * 0x9E3779B97F4A7C15ull >> 17) & mask;
-  while (keys_[s] != kEmpty && keys_[s] != k) s = (s + 1) & mask;
+  const std::size_t mask = slots_.size() - 1;
+  std::size_t s = std::size_t(k * 0x9E3779B97F4A7C15ull >> 32) & mask;
+  while (slots_[s].key != kEmpty && slots_[s].key != k) s = (s + 1) & mask;
   return s;
 }
 
 std::int32_t EdgeMap::find(std::int32_t u, std::int32_t v) const {
-  if (keys_.empty()) return kNone;
-  const std::size_t s = slot(key(u, v));
-  return keys_[s] == kEmpty ? kNone : values_[s];
+  if (slots_.empty()) return kNone;
+  const Slot& s = slots_[slot(key(u, v))];
+  return s.key == kEmpty ? kNone : s.value;
 }
 
 bool EdgeMap::insert(std::int32_t u, std::int32_t v, std::int32_t value, bool overwrite) {
-  if (keys_.empty() || 4 * (used_ + 1) > 3 * keys_.size()) grow();
+  if (slots_.empty() || 4 * (used_ + 1) > 3 * slots_.size()) grow();
   const std::uint64_t k = key(u, v);
-  const std::size_t mask = keys_.size() - 1;
-  std::size_t s = std::size_t(k * 0x9E3779B97F4A7C15ull >> 17) & mask;
-  std::size_t tomb = keys_.size();
-  while (keys_[s] != kEmpty && keys_[s] != k) {
-    if (keys_[s] == kTomb && tomb == keys_.size()) tomb = s;
+  const std::size_t mask = slots_.size() - 1;
+  std::size_t s = std::size_t(k * 0x9E3779B97F4A7C15ull >> 32) & mask;
+  std::size_t tomb = slots_.size();
+  while (slots_[s].key != kEmpty && slots_[s].key != k) {
+    if (slots_[s].key == kTomb && tomb == slots_.size()) tomb = s;
     s = (s + 1) & mask;
   }
-  if (keys_[s] == k) {
+  if (slots_[s].key == k) {
     if (!overwrite) return false;
-    values_[s] = value;
+    slots_[s].value = value;
     return true;
   }
-  if (tomb != keys_.size()) {
+  if (tomb != slots_.size()) {
     s = tomb;
   } else {
     ++used_;
   }
-  keys_[s] = k;
-  values_[s] = value;
+  slots_[s] = {k, value};
   ++size_;
   return true;
 }
 
 void EdgeMap::erase(std::int32_t u, std::int32_t v, std::int32_t value) {
-  if (keys_.empty()) return;
-  const std::size_t s = slot(key(u, v));
-  if (keys_[s] == kEmpty || values_[s] != value) return;
-  keys_[s] = kTomb;
-  values_[s] = kNone;
+  if (slots_.empty()) return;
+  Slot& s = slots_[slot(key(u, v))];
+  if (s.key == kEmpty || s.value != value) return;
+  s = {kTomb, kNone};
   --size_;
 }
 

@@ -160,8 +160,14 @@ Pieces label_pieces(const SkinnedMesh& mesh) {
   std::iota(parent.begin(), parent.end(), 0);
   std::int32_t* const par = parent.data();
   auto find = [par](std::int32_t x) {
-    while (par[x] != x) x = par[x] = par[par[x]];
-    return x;
+    for (;;) {
+      const std::int32_t p = par[x];
+      if (p == x) return x;
+      const std::int32_t g = par[p];
+      if (g == p) return p;  // the usual case: no write
+      par[x] = g;
+      x = g;
+    }
   };
   for (const Face& f : mesh.faces) {
     std::int32_t a = find(f[0]), b = find(f[1]), c = find(f[2]);

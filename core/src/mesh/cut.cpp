@@ -62,10 +62,26 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   if (!(options.snap_fraction >= 0 && options.snap_fraction < 0.5) ||
       !(options.plane_tolerance >= 0))
     throw std::invalid_argument("cut: snap_fraction must be in [0, 0.5) and plane_tolerance ≥ 0");
-  if (mesh.current.cols() != mesh.vertex_count() || !mesh.current.allFinite())
-    throw std::invalid_argument("cut: the current positions must be finite, one per vertex");
   const std::int32_t nv0 = mesh.vertex_count();
   const std::int32_t nf0 = mesh.face_count();
+  if (mesh.current.cols() != nv0)
+    throw std::invalid_argument("cut: the current positions must be finite, one per vertex");
+  // One pass over the positions: finite, and their bounding box (the tolerance's scale).
+  double diagonal = 0;
+  if (nv0 > 0) {
+    const double* x = mesh.current.data();
+    double lo[3] = {x[0], x[1], x[2]}, hi[3] = {x[0], x[1], x[2]};
+    bool finite = true;
+    for (std::int32_t i = 0; i < nv0; ++i, x += 3)
+      for (int k = 0; k < 3; ++k) {
+        finite &= std::isfinite(x[k]);
+        lo[k] = std::min(lo[k], x[k]), hi[k] = std::max(hi[k], x[k]);
+      }
+    if (!finite)
+      throw std::invalid_argument("cut: the current positions must be finite, one per vertex");
+    diagonal = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                         (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  }
   CutResult result;
   result.change.base_vertex_count = nv0;
   result.change.base_face_count = nf0;
@@ -73,32 +89,48 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
 
   std::vector<double> dist;
   classify_vertices(mesh, plane, options.predicates, dist);
-  const double eps = options.plane_tolerance * bounding_diagonal(mesh);
+  const double eps = options.plane_tolerance * diagonal;
   std::vector<std::int8_t> side(static_cast<std::size_t>(nv0));
-  bool any_pos = false, any_neg = false;
+  double reach_pos = 0, reach_neg = 0;  // the farthest vertex on each side
   for (std::int32_t i = 0; i < nv0; ++i) {
     const double s = dist[static_cast<std::size_t>(i)];
     side[static_cast<std::size_t>(i)] = s > eps ? 1 : (s < -eps ? -1 : 0);
-    any_pos |= s > eps, any_neg |= s < -eps;
+    reach_pos = std::max(reach_pos, s), reach_neg = std::max(reach_neg, -s);
   }
-  if (!any_pos || !any_neg) {
+  if (!(reach_pos > eps) || !(reach_neg > eps)) {
     // Every vertex on one side or on the plane: only faces lying in the plane could separate,
     // and they go to the side of the material (opposite their normal), i.e. the same side.
     result.message = "the plane does not cross the mesh";
     return result;
   }
-  // One pass over the faces: index check, and the faces that need work — those not strictly
-  // on one side (crossed, or touching the plane) — in increasing order. The rest only tell
-  // which sides have faces.
+  // Step 2 below snaps a vertex at distance d of the plane only across an edge to a vertex at
+  // distance d' on the other side with |d| < snap / (1 − snap) · |d'|, so only vertices nearer
+  // than that to the plane, measured with the other side's reach, can be snapped: "near".
+  // Per vertex code: 1 on the plane, 2 positive, 8 negative, + 16 when near.
+  const double snap = options.snap_fraction;
+  const double k_snap = snap / (1 - snap) * (1 + 1e-9);  // a margin for rounding
+  const double near_pos = k_snap * reach_neg, near_neg = k_snap * reach_pos;
+  std::vector<std::uint8_t> code(static_cast<std::size_t>(nv0));
+  for (std::int32_t i = 0; i < nv0; ++i) {
+    const double s = dist[static_cast<std::size_t>(i)];
+    const std::int8_t si = side[static_cast<std::size_t>(i)];
+    code[static_cast<std::size_t>(i)] =
+        static_cast<std::uint8_t>((si == 0  ? 1
+                                   : si > 0 ? 2
+                                            : 8) |
+                                  ((si > 0 && s < near_pos) || (si < 0 && -s < near_neg) ? 16 : 0));
+  }
+  // One pass over the faces: index check, and the faces that need work — crossed, touching
+  // the plane, or with a near vertex (which snapping may put on the plane) — in increasing
+  // order. The rest only tell which sides have faces.
   const auto nf = static_cast<std::size_t>(nf0);
   const Face* const faces = mesh.faces.data();
   std::int8_t* const sd = side.data();
+  const std::uint8_t* const cd = code.data();
   std::vector<std::int32_t> work;
   work.reserve(256);
   bool face_pos = false, face_neg = false;
-  auto scan = [nf, nv0, faces, sd](std::vector<std::int32_t>& out, bool& pos, bool& neg) {
-    out.clear();
-    // A face is strictly on one side when the OR of its vertices' side codes is one code.
+  {
     int any = 0;
     const auto bound = static_cast<std::uint32_t>(nv0);
     for (std::size_t fi = 0; fi < nf; ++fi) {
@@ -107,22 +139,18 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
                  c = static_cast<std::uint32_t>(f[2]);
       if ((a >= bound) | (b >= bound) | (c >= bound))
         throw std::invalid_argument("cut: face index out of range");
-      // side & 3 is 1 (+), 3 (−) or 0 (on the plane): codes 2, 8 and 1.
-      const int code = (1 << (sd[a] & 3)) | (1 << (sd[b] & 3)) | (1 << (sd[c] & 3));
-      if (code == 2 || code == 8) {
-        any |= code;
+      const int fc = cd[a] | cd[b] | cd[c];
+      if (fc == 2 || fc == 8) {  // strictly on one side, no vertex near the plane
+        any |= fc;
         continue;
       }
-      out.push_back(static_cast<std::int32_t>(fi));
+      work.push_back(static_cast<std::int32_t>(fi));
     }
-    pos = (any & 2) != 0, neg = (any & 8) != 0;
-  };
-  scan(work, face_pos, face_neg);
+    face_pos = (any & 2) != 0, face_neg = (any & 8) != 0;
+  }
 
   // Snap crossings that fall too close to an end of their edge onto that end (only faces in
-  // `work` have crossed edges). Snapping can make faces strictly on one side touch the plane:
-  // then the faces are scanned again.
-  const double snap = options.snap_fraction;
+  // `work` have crossed edges, and every face around a vertex that may be snapped is there).
   for (const std::int32_t fi : work) {
     const Face& f = faces[fi];
     for (int k = 0; k < 3; ++k) {
@@ -138,7 +166,6 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
         sb = 0, ++result.snapped_vertices;
     }
   }
-  if (result.snapped_vertices > 0) scan(work, face_pos, face_neg);
 
   TopologyChange& ch = result.change;
   EdgeMap crossing;  // (lower, higher) vertex → crossing vertex id

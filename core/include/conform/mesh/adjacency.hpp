@@ -38,8 +38,12 @@ class EdgeMap {
   void rehash(std::size_t capacity);
   static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
   static constexpr std::uint64_t kTomb = ~std::uint64_t(0) - 1;
-  std::vector<std::uint64_t> keys_;
-  std::vector<std::int32_t> values_;
+  // Key and value side by side: one cache line per probe.
+  struct Slot {
+    std::uint64_t key;
+    std::int32_t value;
+  };
+  std::vector<Slot> slots_;
   std::size_t size_ = 0, used_ = 0;  // live entries; live + tombstones
 };
 
