@@ -78,8 +78,8 @@ template <class T>
                                                T pz) {
   const T rho2 = px * px + py * py;
   const T r2 = rho2 + pz * pz;
-  // r2 − r2 == 0: finite (no NaN, no overflow); false for NaN in every comparison.
-  return (r2 - r2 == T(0)) & (r2 > c.tiny2) & (rho2 > c.axis_tol2 * r2);
+  // False for NaN in every comparison; the bound also excludes ±inf.
+  return (r2 > c.tiny2) & (r2 < detail::kCommonMax<T>)&(rho2 > c.axis_tol2 * r2);
 }
 
 template <class T>
@@ -160,16 +160,53 @@ Solution<T> solve_dir(const Arm<T>& arm, const detail::KernelConstants<T>& c, co
 
 }  // namespace
 
+namespace {
+
+// The free solve()'s arm constants: kept per thread for the last arm seen (compared field by
+// field, so any change of the arm recomputes them), as callers mostly solve for one arm.
+template <class T>
+struct ArmCache {
+  Arm<T> arm{T(-1), T(-1), {}};  // invalid: never equal to a valid arm
+  detail::KernelConstants<T> constants{};
+  bool valid = false;
+};
+
+template <class T>
+bool same_arm(const Arm<T>& a, const Arm<T>& b) {
+  const JointLimits<T>&la = a.limits, &lb = b.limits;
+  return (a.upper == b.upper) & (a.fore == b.fore) & (la.elbow_min == lb.elbow_min) &
+         (la.elbow_max == lb.elbow_max) & (la.cone_half_angle == lb.cone_half_angle) &
+         (la.cone_axis.x() == lb.cone_axis.x()) & (la.cone_axis.y() == lb.cone_axis.y()) &
+         (la.cone_axis.z() == lb.cone_axis.z());
+}
+
+template <class T>
+const ArmCache<T>& arm_cache(const Arm<T>& arm) {
+  thread_local ArmCache<T> cache;
+  if (!same_arm(arm, cache.arm)) [[unlikely]] {
+    cache.arm = arm;
+    cache.valid = arm.valid();
+    if (cache.valid) cache.constants = constants(arm);
+  }
+  return cache;
+}
+
+}  // namespace
+
 template <class T>
 Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, T swivel) {
-  if (!arm.valid()) return invalid_arm<T>();
-  return solve_angle(arm, constants(arm), target, swivel);
+  const ArmCache<T>& cache = arm_cache(arm);
+  if (!cache.valid) [[unlikely]]
+    return invalid_arm<T>();
+  return solve_angle(arm, cache.constants, target, swivel);
 }
 
 template <class T>
 Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, SwivelCosSin<T> swivel) {
-  if (!arm.valid()) return invalid_arm<T>();
-  return solve_dir(arm, constants(arm), target, swivel);
+  const ArmCache<T>& cache = arm_cache(arm);
+  if (!cache.valid) [[unlikely]]
+    return invalid_arm<T>();
+  return solve_dir(arm, cache.constants, target, swivel);
 }
 
 template Solution<float> solve(const Arm<float>&, const Vec3<float>&, float);

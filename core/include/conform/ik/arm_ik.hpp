@@ -21,8 +21,8 @@
 // Three solvers give the same answer: solve_readable (the algebra, arm_ik_readable.cpp),
 // solve / ArmSolver (the closed form, scalar) and BatchSolveJob (the closed form over
 // structure-of-arrays data, SIMD and OpenMP threads). See arm_ik_readable.cpp for every sign
-// changed vs the paper. For many solves with one arm, ArmSolver computes the arm's constants
-// once; solve(arm, …) computes them on every call.
+// changed vs the paper. ArmSolver computes the arm's constants once; solve(arm, …) keeps them
+// per thread for the last arm it saw.
 #pragma once
 
 #include <cmath>
@@ -133,7 +133,8 @@ struct SwivelCosSin {
 };
 
 /// Fast closed form (eqs 10–18 re-derived for accuracy), one target. Honours all limits.
-/// Computes the arm's constants on every call; ArmSolver keeps them.
+/// The arm's constants are kept per thread for the last arm seen (recomputed when any field
+/// of the arm differs); ArmSolver keeps them explicitly.
 template <class T>
 Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, T swivel);
 template <class T>

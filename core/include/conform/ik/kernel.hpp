@@ -220,6 +220,12 @@ struct KernelResult {
 inline constexpr std::uint8_t kBitOuter = 1, kBitInner = 2, kBitShoulder = 4, kBitTargetAxis = 8,
                               kBitElbowAxis = 16, kBitElbowLimit = 32, kBitInvalid = 128;
 
+/// √x and 1/√x.
+template <class T>
+struct Root {
+  T root, inv;
+};
+
 /// Selects and roots of the vector path: bool conditions, sel(), rsqrt() and sqrt() above.
 template <class T>
 struct VectorOps {
@@ -228,12 +234,18 @@ struct VectorOps {
   [[gnu::always_inline]] static T pick(Mask m, T a, T b) { return sel(m, a, b); }
   [[gnu::always_inline]] static T sqrt(T x) { return detail::sqrt(x); }
   [[gnu::always_inline]] static T rsqrt(T x) { return detail::rsqrt(x); }
+  [[gnu::always_inline]] static Root<T> root(T x) {
+    const T inv = detail::rsqrt(x);
+    return {x * inv, inv};
+  }
+  [[gnu::always_inline]] static Root<T> root_parallel(T x) { return root(x); }
 };
 
 /// Selects and roots for one solve. With SSE2 the comparison masks stay in the vector
 /// registers (sel() goes through the integer registers when it is not vectorized, and a plain
 /// ?: becomes a branch, mispredicted with random targets) and the roots skip std::sqrt's errno
-/// check (its arguments here are never negative).
+/// check (its arguments here are never negative). root_parallel(x) = {√x, √x · (1/x)}: the root
+/// and the division run side by side (half the latency of 1/√x; for 1/x a normal number).
 template <class T>
 struct ScalarOps {
   using Mask = bool;
@@ -241,6 +253,14 @@ struct ScalarOps {
   [[gnu::always_inline]] static T pick(Mask m, T a, T b) { return sel(m, a, b); }
   static T sqrt(T x) { return std::sqrt(x); }
   static T rsqrt(T x) { return T(1) / std::sqrt(x); }
+  static Root<T> root(T x) {
+    const T r = std::sqrt(x);
+    return {r, T(1) / r};
+  }
+  static Root<T> root_parallel(T x) {
+    const T r = std::sqrt(x);
+    return {r, r * (T(1) / x)};
+  }
 };
 #if defined(__SSE2__)
 template <>
@@ -260,6 +280,14 @@ struct ScalarOps<double> {
     return _mm_cvtsd_f64(_mm_sqrt_sd(v, v));
   }
   [[gnu::always_inline]] static double rsqrt(double x) { return 1.0 / sqrt(x); }
+  [[gnu::always_inline]] static Root<double> root(double x) {
+    const double r = sqrt(x);
+    return {r, 1.0 / r};
+  }
+  [[gnu::always_inline]] static Root<double> root_parallel(double x) {
+    const double r = sqrt(x);
+    return {r, r * (1.0 / x)};
+  }
 };
 template <>
 struct ScalarOps<float> {
@@ -277,15 +305,28 @@ struct ScalarOps<float> {
     return _mm_cvtss_f32(_mm_sqrt_ss(_mm_set_ss(x)));
   }
   [[gnu::always_inline]] static float rsqrt(float x) { return 1.0f / sqrt(x); }
+  [[gnu::always_inline]] static Root<float> root(float x) {
+    const float r = sqrt(x);
+    return {r, 1.0f / r};
+  }
+  [[gnu::always_inline]] static Root<float> root_parallel(float x) {
+    const float r = sqrt(x);
+    return {r, r * (1.0f / x)};
+  }
 };
 #endif
+
+/// The common path's bound on |Pw|²: 1/|Pw|² stays a normal number.
+template <class T>
+inline constexpr T kCommonMax = std::is_same_v<T, float> ? T(1e36) : T(1e300);
 
 /// The paths of solve_kernel_cs.
 enum class Path {
   kVector,  // SIMD lanes: every case by selects, roots by rsqrt()
   kScalar,  // one solve: every case by selects, roots by std::sqrt and division
   kCommon,  // one solve, the caller has checked: valid input, not at the shoulder, not on the
-            // z axis (the three rare cases' selects are left out)
+            // z axis, |Pw|² < kCommonMax (the rare cases' selects are left out; 1/√x is
+            // computed as √x · (1/x), whose two operations do not wait for each other)
 };
 
 /// One solve from the target and the swivel as (cos φ, sin φ), a unit pair. `swivel_ok`
@@ -336,7 +377,15 @@ template <class T, Path kPath = Path::kVector>
 
   // The roots that depend on the inputs only run side by side: 1/|P|, 1/|n0| and the
   // half-angles of the flexion (eq 14) from the clamped |Pw|².
-  const T inv_r = Ops::rsqrt(r2d);
+  const auto root = [](T x) {
+    if constexpr (kPath == Path::kCommon) {
+      return Ops::root_parallel(x);
+    } else {
+      return Ops::root(x);
+    }
+  };
+  const Root<T> len = root(r2d);
+  const T inv_r = len.inv;
   // diff2 ≤ reach_min2 ≤ l2 ≤ reach_max2 ≤ sum2 (also after rounding): both factors ≥ 0.
   const T l2 = at_most(at_least(r2s, c.reach_min2), c.reach_max2);
   const T ce = Ops::sqrt((l2 - c.diff2) * c.k2);  // cos(θ4/2)
@@ -348,10 +397,10 @@ template <class T, Path kPath = Path::kVector>
   const T n0x = kRare ? sel(on_axis, T(0), py) : py;
   const T n0y = kRare ? sel(on_axis, pz, -px) : -px;
   const T n0z = kRare ? sel(on_axis, -py, T(0)) : T(0);
-  const T inv_n0 = Ops::rsqrt(kRare ? sel(on_axis, py * py + pz * pz, rho2) : rho2);
+  const T inv_n0 = root(kRare ? sel(on_axis, py * py + pz * pz, rho2) : rho2).inv;
 
   // The clamped distance (eq 10): the clamp decides 1/L.
-  const T l0 = kRare ? sel(at_shoulder, T(0), r2d * inv_r) : r2d * inv_r;
+  const T l0 = kRare ? sel(at_shoulder, T(0), len.root) : len.root;
   const T inv_l = Ops::pick(Ops::less(c.reach_max2, r2s), c.inv_reach_max,
                             Ops::pick(Ops::less(r2s, c.reach_min2), c.inv_reach_min, inv_r));
 
@@ -392,7 +441,7 @@ template <class T, Path kPath = Path::kVector>
   const T vy = pick(low, pick(c01, sxy, t), pick(c0m, syz, dwy));
   const T vz = pick(low, pick(c01, sxz, syz), pick(c0m, t, dwz));
   // q = v / (2√t); the sign makes w ≥ 0.
-  const T half_rt = T(0.5) * Ops::rsqrt(t);
+  const T half_rt = T(0.5) * root(t).inv;
   const T k = pick(Ops::less(vw, T(0)), -half_rt, half_rt);
 
   KernelResult<T> r;
