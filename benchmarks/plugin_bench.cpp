@@ -39,6 +39,37 @@ struct LiveArm {
   }
 };
 
+// Where an edit's time went (ApplyStats::seconds, wall clock), averaged over the iterations,
+// in ms: the plugin's own share (sync of the simulated positions + the mirror into Bullet, by
+// phase) and the mesh side (computing the change and applying it to the mesh, in core).
+struct Phases {
+  bullet::ApplyStats::Seconds sum;
+  int n = 0;
+  void add(const bullet::ApplyStats& stats) {
+    const auto& s = stats.seconds;
+    sum.sync += s.sync, sum.mesh += s.mesh, sum.vertices += s.vertices, sum.faces += s.faces;
+    sum.pieces += s.pieces, sum.split += s.split, sum.insert += s.insert;
+    ++n;
+    last = stats;
+  }
+  bullet::ApplyStats last;
+  void report(benchmark::State& state) const {
+    const double k = n ? 1e3 / n : 0;
+    state.counters["mesh_ms"] = k * sum.mesh;
+    state.counters["plugin_ms"] = k * (sum.sync + sum.mirror());
+    state.counters["sync_ms"] = k * sum.sync;
+    state.counters["vert_ms"] = k * sum.vertices;
+    state.counters["faces_ms"] = k * sum.faces;
+    state.counters["pieces_ms"] = k * sum.pieces;
+    state.counters["split_ms"] = k * sum.split;
+    state.counters["insert_ms"] = k * sum.insert;
+    state.counters["+faces"] = last.added_faces;
+    state.counters["-faces"] = last.removed_faces;
+    state.counters["+nodes"] = last.new_nodes;
+    state.counters["searched"] = last.searched_vertices;
+  }
+};
+
 void BM_StepSkinned(benchmark::State& state) {
   LiveArm a(10, double(state.range(0)) / 100);
   for (auto _ : state) a.w.step();
@@ -92,20 +123,27 @@ BENCHMARK(BM_SkinTargets)->Unit(benchmark::kMicrosecond);
 // A plane across the forearm of a live arm: compute the cut on the simulated positions, apply
 // it to the mesh and to Bullet (the arm splits into two bodies).
 void BM_CutLiveArm(benchmark::State& state) {
+  Phases phases;
+  int moved = 0;
   for (auto _ : state) {
     state.PauseTiming();
     auto a = std::make_unique<LiveArm>();
     state.ResumeTiming();
     a->body->cut(cga::Plane<double>::from_normal_point({0.1, 0, 1}, {0, 0, 0.42}));
     state.PauseTiming();
+    phases.add(a->body->last_apply());
+    moved = a->body->last_apply().moved_nodes;
     a.reset();
     state.ResumeTiming();
   }
+  phases.report(state);
+  state.counters["moved"] = moved;
 }
-BENCHMARK(BM_CutLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(3);
+BENCHMARK(BM_CutLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(5);
 
 // Only the application of an already computed cut (mesh + Bullet mirror).
 void BM_ApplyCutLiveArm(benchmark::State& state) {
+  Phases phases;
   for (auto _ : state) {
     state.PauseTiming();
     auto a = std::make_unique<LiveArm>();
@@ -115,14 +153,17 @@ void BM_ApplyCutLiveArm(benchmark::State& state) {
     state.ResumeTiming();
     a->body->apply(result.change);
     state.PauseTiming();
+    phases.add(a->body->last_apply());
     a.reset();
     state.ResumeTiming();
   }
+  phases.report(state);
 }
-BENCHMARK(BM_ApplyCutLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(3);
+BENCHMARK(BM_ApplyCutLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(5);
 
 // One tear step (a blade sample advancing an open tear on the upper arm), compute + apply.
 void BM_TearStepLiveArm(benchmark::State& state) {
+  Phases phases;
   for (auto _ : state) {
     state.PauseTiming();
     auto a = std::make_unique<LiveArm>();
@@ -135,14 +176,18 @@ void BM_TearStepLiveArm(benchmark::State& state) {
     state.ResumeTiming();
     a->body->tear_advance({6.0, {0, 0, 0.116}, {0.15, 0, 0.116}});
     state.PauseTiming();
+    phases.add(a->body->last_apply());
     a.reset();
     state.ResumeTiming();
   }
+  phases.report(state);
 }
-BENCHMARK(BM_TearStepLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(3);
+BENCHMARK(BM_TearStepLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(5);
 
 // A 1 cm drill through both walls of the upper arm, compute + apply.
 void BM_DrillLiveArm(benchmark::State& state) {
+  Phases phases;
+  int detached = 0;
   for (auto _ : state) {
     state.PauseTiming();
     auto a = std::make_unique<LiveArm>(1);
@@ -150,11 +195,42 @@ void BM_DrillLiveArm(benchmark::State& state) {
     state.ResumeTiming();
     a->body->drill({c + Eigen::Vector3d(0, 0.2, 0), c - Eigen::Vector3d(0, 0.2, 0), 0.01});
     state.PauseTiming();
+    phases.add(a->body->last_apply());
+    detached = a->body->detached_count();
+    a.reset();
+    state.ResumeTiming();
+  }
+  phases.report(state);
+  state.counters["detached"] = detached;
+}
+BENCHMARK(BM_DrillLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(5);
+
+// The first physics step after an edit (a cut that splits the arm, or a drill): Bullet does
+// no whole-body reset (the plugin wrote the constants of what changed), so it should cost
+// about a normal step of the same bodies (BM_StepAfterEdit/…/settled, a later step).
+void BM_StepAfterEdit(benchmark::State& state) {
+  const bool cut = state.range(0) == 1, settled = state.range(1) == 1;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto a = std::make_unique<LiveArm>();
+    if (cut)
+      a->body->cut(cga::Plane<double>::from_normal_point({0.1, 0, 1}, {0, 0, 0.42}));
+    else
+      a->body->drill({Eigen::Vector3d(0, 0.2, 0.15), Eigen::Vector3d(0, -0.2, 0.15), 0.01});
+    if (settled) a->w.step(3);
+    state.ResumeTiming();
+    a->w.step();
+    state.PauseTiming();
     a.reset();
     state.ResumeTiming();
   }
 }
-BENCHMARK(BM_DrillLiveArm)->Unit(benchmark::kMillisecond)->Iterations(30)->Repetitions(3);
+BENCHMARK(BM_StepAfterEdit)
+    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->ArgNames({"cut", "settled"})
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(30)
+    ->Repetitions(5);
 
 // Steps per second of a torn, pre-tensioned 40×40 patch while it opens.
 void BM_OpeningTearStep(benchmark::State& state) {
@@ -200,5 +276,10 @@ int main(int argc, char** argv) {
     conform::bench::add_ratio(std::string("BM_StepSkinnedStill/") + s + "/min_time:1.000", base,
                               std::string("still skinned / unskinned, s = 0.0") + s);
   }
+  for (const char* e : {"0", "1"})
+    conform::bench::add_ratio(
+        std::string("BM_StepAfterEdit/cut:") + e + "/settled:0/iterations:30/repeats:5",
+        std::string("BM_StepAfterEdit/cut:") + e + "/settled:1/iterations:30/repeats:5",
+        std::string("first step after ") + (e[0] == '1' ? "a cut" : "a drill") + " / a later step");
   return conform::bench::run_with_ratios(argc, argv);
 }

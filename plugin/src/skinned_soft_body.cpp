@@ -3,8 +3,8 @@
 #include <BulletSoftBody/btSoftBody.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -51,10 +51,19 @@ struct SkinnedSoftBody::Piece {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point& t) {
-  const auto now = Clock::now();
-  const double s = std::chrono::duration<double>(now - t).count();
+// Phase timings: CPU time of the calling thread (steadier than wall time on a shared machine;
+// the edits run on the caller's thread).
+struct Clock {
+  using time_point = double;
+  static double now() {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+  }
+};
+double seconds_since(double& t) {
+  const double now = Clock::now();
+  const double s = now - t;
   t = now;
   return s;
 }
@@ -225,7 +234,9 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
       }
   for (std::int32_t v = 0; v < m.vertex_count(); ++v)
     if (piece_of_[static_cast<std::size_t>(v)] >= 0) update_node_area(v);
-  relink_.clear();
+  area_mark_.assign(n, 0);
+  seed_mark_.assign(n, 0);
+  clear_kept();
   bend_dirty_.clear();
   stats_ = {};
 }
@@ -427,8 +438,7 @@ void SkinnedSoftBody::remove_bending(std::int32_t a, std::int32_t b) {
   const btSoftBody::Link& l = body.m_links[li];
   const std::int32_t c = piece.node_vertex[static_cast<std::size_t>(l.m_n[0] - &body.m_nodes[0])],
                      d = piece.node_vertex[static_cast<std::size_t>(l.m_n[1] - &body.m_nodes[0])];
-  relink_.emplace_back(a, b, std::min(c, d), std::max(c, d),
-                       piece.rest[static_cast<std::size_t>(li)]);
+  keep_rest(a, b, std::min(c, d), std::max(c, d), piece.rest[static_cast<std::size_t>(li)], true);
   remove_link(p, li);
   --stats_.removed_links;
   ++stats_.removed_bending;
@@ -461,6 +471,29 @@ void SkinnedSoftBody::remove_link(std::int32_t p, std::int32_t li) {
   ++stats_.removed_links;
 }
 
+void SkinnedSoftBody::keep_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
+                                double rest, bool bending) {
+  (bending ? relink_bend_ : relink_edge_).insert(a, b, std::int32_t(relink_.size()), true);
+  relink_.emplace_back(a, b, c, d, rest);
+}
+
+double SkinnedSoftBody::kept_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
+                                  bool bending) const {
+  const std::int32_t i = (bending ? relink_bend_ : relink_edge_).find(a, b);
+  if (i < 0) return -1;
+  const auto& [ka, kb, kc, kd, rest] = relink_[static_cast<std::size_t>(i)];
+  return kc == c && kd == d ? rest : -1;
+}
+
+void SkinnedSoftBody::clear_kept() {
+  for (std::size_t i = 0; i < relink_.size(); ++i) {
+    const auto& [a, b, c, d, rest] = relink_[i];
+    const bool bending = !(a == c && b == d);
+    (bending ? relink_bend_ : relink_edge_).erase(a, b, std::int32_t(i));
+  }
+  relink_.clear();
+}
+
 void SkinnedSoftBody::refresh_bending(std::int32_t a, std::int32_t b) {
   // A bending link across (a, b) iff exactly two faces use the edge, both in the same body;
   // it joins their third vertices. A link of the same vertices removed earlier in this change
@@ -480,12 +513,7 @@ void SkinnedSoftBody::refresh_bending(std::int32_t a, std::int32_t b) {
   const std::int32_t c = third_vertex(faces_[static_cast<std::size_t>(found[0])], a, b),
                      d = third_vertex(faces_[static_cast<std::size_t>(found[1])], a, b);
   if (c < 0 || d < 0 || c == d) return;
-  double rest = -1;
-  const std::tuple key{a, b, std::min(c, d), std::max(c, d), -1.0};
-  const auto it = std::lower_bound(relink_.begin(), relink_.end(), key);  // relink_ is sorted
-  if (it != relink_.end() && std::get<0>(*it) == a && std::get<1>(*it) == b &&
-      std::get<2>(*it) == std::get<2>(key) && std::get<3>(*it) == std::get<3>(key))
-    rest = std::get<4>(*it);
+  double rest = kept_rest(a, b, std::min(c, d), std::max(c, d), true);
   if (rest < 0) rest = (1 - material_.pretension) * (position(c) - position(d)).norm();
   add_bending(p, a, b, c, d, rest);
 }
@@ -501,7 +529,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   if (mesh_.vertex_count() < v0 + nnew)
     throw std::logic_error("SkinnedSoftBody: mesh lacks the change's new vertices");
   const bool bending = material_.bending_stiffness > 0;
-  relink_.clear();
+  clear_kept();
   bend_dirty_.clear();
 
   // 1. New vertices: x and v interpolated from the parents; mass taken from the parents in
@@ -558,13 +586,18 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   // 2. Removed faces leave Bullet; edges no face uses any more lose their link (kept aside:
   // an edge that comes back in the same change keeps its rest length).
   std::vector<std::int32_t> seeds;  // vertices around the change (their pieces may split)
+  seed_mark_.resize(total, 0);
+  auto seed = [&](std::int32_t v) {
+    auto& mark = seed_mark_[static_cast<std::size_t>(v)];
+    if (!mark) mark = 1, seeds.push_back(v);
+  };
   std::vector<std::pair<std::int32_t, std::int32_t>> dropped;
   for (const auto f : change.removed_faces) {
     const auto tri = faces_[static_cast<std::size_t>(f)];
     remove_face_from_bullet(f);
     for (int k = 0; k < 3; ++k) {
       erase_value(vertex_faces_[static_cast<std::size_t>(tri[k])], f);
-      seeds.push_back(tri[k]);
+      seed(tri[k]);
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
       const std::int32_t c = edge_faces_.find(a, b) - 1;
       if (c > 0) {
@@ -579,7 +612,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     const std::int32_t li = edge_link_.find(a, b);
     if (li < 0) continue;
     const std::int32_t p = piece_of_[static_cast<std::size_t>(a)];
-    relink_.emplace_back(a, b, a, b, pieces_[static_cast<std::size_t>(p)]->rest[std::size_t(li)]);
+    keep_rest(a, b, a, b, pieces_[static_cast<std::size_t>(p)]->rest[std::size_t(li)], false);
     remove_link(p, li);
   }
 
@@ -622,7 +655,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     const auto& tri = faces_[static_cast<std::size_t>(f)];
     for (int k = 0; k < 3; ++k) {
       vertex_faces_[static_cast<std::size_t>(tri[k])].push_back(f);
-      seeds.push_back(tri[k]);
+      seed(tri[k]);
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
       const std::int32_t c = edge_faces_.find(a, b);
       edge_faces_.insert(a, b, c < 0 ? 1 : c + 1, true);
@@ -630,9 +663,8 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   }
   stats_.added_faces += std::int32_t(pending.size());
   stats_.new_nodes += nnew;
-  for (std::int32_t i = 0; i < nnew; ++i) seeds.push_back(v0 + i);
-  std::sort(seeds.begin(), seeds.end());
-  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  for (std::int32_t i = 0; i < nnew; ++i) seed(v0 + i);
+  for (const auto v : seeds) seed_mark_[static_cast<std::size_t>(v)] = 0;
   sec.faces += seconds_since(clock);
 
   // 4. Connected pieces around the change. A piece can only split where faces changed, so one
@@ -661,21 +693,21 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     search_label_[i] = std::int32_t(searches.size());
     searches.push_back({{v}, 0, std::int32_t(searches.size())});
   }
-  std::vector<std::int32_t> active, roots;
+  std::vector<std::int32_t> active;
   for (std::size_t s = 0; s < searches.size(); ++s) active.push_back(std::int32_t(s));
+  // Per root: its searches that still have vertices to expand; groups with any.
+  std::vector<std::int32_t> pending_in(searches.size(), 1);
+  auto growing = std::int32_t(searches.size());
   std::int32_t open_root = -1, open_piece = -1;
   bool to_the_end = false;
   while (!active.empty()) {
-    roots.clear();
-    for (const auto s : active) roots.push_back(root_of(s));
-    std::sort(roots.begin(), roots.end());
-    roots.erase(std::unique(roots.begin(), roots.end()), roots.end());
-    if (roots.size() == 1 && !to_the_end) {
+    if (growing == 1 && !to_the_end) {
       // Which bodies does the growing group touch so far?
+      const std::int32_t root = root_of(active[0]);
       std::int32_t piece = -1;
       bool several = false;
       for (std::size_t s = 0; s < searches.size() && !several; ++s) {
-        if (root_of(std::int32_t(s)) != roots[0]) continue;
+        if (root_of(std::int32_t(s)) != root) continue;
         for (const auto v : searches[s].queue) {
           const std::int32_t p = piece_of_[static_cast<std::size_t>(v)];
           if (p < 0) continue;
@@ -684,7 +716,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
         }
       }
       if (piece >= 0 && !several) {
-        open_root = roots[0];
+        open_root = root;
         open_piece = piece;
         break;
       }
@@ -693,23 +725,32 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     std::size_t kept = 0;
     for (const auto s : active) {
       auto& search = searches[static_cast<std::size_t>(s)];
-      if (search.head < search.queue.size()) {
-        const std::int32_t u = search.queue[search.head++];
-        for (const auto f : vertex_faces_[static_cast<std::size_t>(u)])
-          for (const auto w : faces_[static_cast<std::size_t>(f)]) {
-            std::int32_t& label = search_label_[static_cast<std::size_t>(w)];
-            if (label < 0) {
-              label = s;
-              searches[static_cast<std::size_t>(s)].queue.push_back(w);
-            } else {
-              const std::int32_t a = root_of(label), b = root_of(s);
-              if (a != b) searches[static_cast<std::size_t>(std::max(a, b))].root = std::min(a, b);
-            }
+      const std::int32_t u = search.queue[search.head++];
+      std::int32_t rs = root_of(s);
+      for (const auto f : vertex_faces_[static_cast<std::size_t>(u)])
+        for (const auto w : faces_[static_cast<std::size_t>(f)]) {
+          std::int32_t& label = search_label_[static_cast<std::size_t>(w)];
+          if (label < 0) {
+            label = s;
+            searches[static_cast<std::size_t>(s)].queue.push_back(w);
+            continue;
           }
-      }
-      if (searches[static_cast<std::size_t>(s)].head <
-          searches[static_cast<std::size_t>(s)].queue.size())
+          const std::int32_t rw = root_of(label);
+          if (rw == rs) continue;
+          const std::int32_t r = std::min(rw, rs), o = std::max(rw, rs);
+          auto& pr = pending_in[static_cast<std::size_t>(r)];
+          auto& po = pending_in[static_cast<std::size_t>(o)];
+          if (pr > 0 && po > 0) --growing;
+          pr += po;
+          po = 0;
+          searches[static_cast<std::size_t>(o)].root = r;
+          rs = r;
+        }
+      const auto& done = searches[static_cast<std::size_t>(s)];
+      if (done.head < done.queue.size())
         active[kept++] = s;
+      else if (--pending_in[static_cast<std::size_t>(rs)] == 0)
+        --growing;
     }
     active.resize(kept);
   }
@@ -770,6 +811,8 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
 
   // 5. Moves (splits and merges): the moving nodes' faces and links leave their old body, the
   // nodes follow with x, v and mass exactly, and the faces and links are rebuilt in the new one.
+  std::vector<std::int32_t> moved_faces;
+  std::vector<std::tuple<std::int32_t, std::int32_t, double>> moved_links;  // (a, b, rest)
   for (std::size_t c = 0; c < components.size(); ++c) {
     std::vector<std::int32_t> moving;
     for (const auto v : components[c]) {
@@ -778,8 +821,13 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     }
     if (moving.empty()) continue;
     if (owner[c] < 0) {
-      new_piece();
+      btSoftBody& body = *new_piece().body;
       owner[c] = std::int32_t(pieces_.size()) - 1;
+      // An empty body: reserving moves nothing that is pointed to.
+      const auto n = int(moving.size());
+      body.m_nodes.reserve(n);
+      body.m_faces.reserve(2 * n + 16);
+      body.m_links.reserve(3 * n + 16);
     }
     std::vector<std::pair<btVector3, btVector3>> state;
     for (const auto v : moving) {
@@ -788,15 +836,14 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
         const auto tri = faces_[static_cast<std::size_t>(f)];
         remove_face_from_bullet(f);
         --stats_.removed_faces;  // re-added below: counted as moved, not removed
-        pending.push_back(f);
+        moved_faces.push_back(f);
         for (int k = 0; k < 3; ++k) {
           const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
           const std::int32_t li = edge_link_.find(a, b);
-          if (li < 0) continue;
+          if (li < 0) continue;  // moved already (from the face across)
           const std::int32_t lp = piece_of_[static_cast<std::size_t>(a)];
-          relink_.emplace_back(
-              a, b, a, b,
-              pieces_[static_cast<std::size_t>(lp)]->rest[static_cast<std::size_t>(li)]);
+          moved_links.emplace_back(
+              a, b, pieces_[static_cast<std::size_t>(lp)]->rest[static_cast<std::size_t>(li)]);
           remove_link(lp, li);
           --stats_.removed_links;
         }
@@ -804,7 +851,14 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       const btSoftBody::Node& node = body_of(v)->m_nodes[node_of_[static_cast<std::size_t>(v)]];
       state.emplace_back(node.m_x, node.m_v);
     }
-    for (const auto v : moving) remove_node(v);
+    {
+      // Highest node first: the last nodes of a body are popped without a swap.
+      std::vector<std::int32_t> order = moving;
+      std::sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) {
+        return node_of_[static_cast<std::size_t>(x)] > node_of_[static_cast<std::size_t>(y)];
+      });
+      for (const auto v : order) remove_node(v);
+    }
     for (std::size_t i = 0; i < moving.size(); ++i) {
       add_node(owner[c], moving[i], to_eigen(state[i].first), to_eigen(state[i].second));
       // Bit-exact copy (the double round trip is exact, but say so in code).
@@ -848,13 +902,25 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   }
   for (const auto& s : searches)
     for (const auto v : s.queue) search_label_[static_cast<std::size_t>(v)] = -1;
-  for (const auto v : touched) set_node_mass(v);
+  for (const auto v : touched) {  // once each (seed_mark_ is clear here)
+    auto& mark = seed_mark_[static_cast<std::size_t>(v)];
+    if (!mark) mark = 1, set_node_mass(v);
+  }
+  for (const auto v : touched) seed_mark_[static_cast<std::size_t>(v)] = 0;
 
   // 7. Faces and links into Bullet; a moved link keeps its rest length, a new one gets
   // (1 − s) × its current length. Then bending links of the edges whose faces changed.
-  std::sort(pending.begin(), pending.end());
-  pending.erase(std::unique(pending.begin(), pending.end()), pending.end());
-  std::sort(relink_.begin(), relink_.end());
+  for (const auto f : moved_faces)
+    add_face(piece_of_[static_cast<std::size_t>(faces_[static_cast<std::size_t>(f)][0])], f);
+  for (const auto& [a, b, rest] : moved_links) {
+    add_link(piece_of_[static_cast<std::size_t>(a)], a, b, rest);
+    --stats_.added_links;
+  }
+  if (bending)
+    for (const auto f : moved_faces) {
+      const auto& tri = faces_[static_cast<std::size_t>(f)];
+      for (int k = 0; k < 3; ++k) bend_dirty_.push_back(edge_key(tri[k], tri[(k + 1) % 3]));
+    }
   for (const auto f : pending) {
     if (face_piece_[static_cast<std::size_t>(f)] >= 0) continue;
     const auto tri = faces_[static_cast<std::size_t>(f)];
@@ -864,11 +930,9 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
       if (bending) bend_dirty_.emplace_back(a, b);
       if (edge_link_.find(a, b) >= 0) continue;
-      const std::tuple key{a, b, a, b, -1.0};
-      auto it = std::lower_bound(relink_.begin(), relink_.end(), key);
-      if (it != relink_.end() && std::get<0>(*it) == a && std::get<1>(*it) == b &&
-          std::get<2>(*it) == a && std::get<3>(*it) == b) {
-        add_link(p, a, b, std::get<4>(*it));
+      const double kept = kept_rest(a, b, a, b, false);
+      if (kept >= 0) {
+        add_link(p, a, b, kept);
         --stats_.added_links;
       } else {
         add_link(p, a, b, (1 - material_.pretension) * (position(a) - position(b)).norm());
@@ -880,9 +944,23 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     bend_dirty_.erase(std::unique(bend_dirty_.begin(), bend_dirty_.end()), bend_dirty_.end());
     for (const auto& [a, b] : bend_dirty_) refresh_bending(a, b);
   }
-  for (const auto v : seeds) update_node_area(v);
+  area_mark_.resize(total, 0);
+  auto area = [&](std::int32_t v) {
+    auto& mark = area_mark_[static_cast<std::size_t>(v)];
+    if (!mark) mark = 1, update_node_area(v);
+  };
+  for (const auto v : seeds) area(v);
   for (const auto f : pending)
-    for (const auto v : faces_[static_cast<std::size_t>(f)]) update_node_area(v);
+    for (const auto v : faces_[static_cast<std::size_t>(f)]) area(v);
+  for (const auto v : seeds) area_mark_[static_cast<std::size_t>(v)] = 0;
+  for (const auto f : moved_faces)
+    for (const auto v : faces_[static_cast<std::size_t>(f)]) area(v);
+  for (const auto f : moved_faces)
+    for (const auto v : faces_[static_cast<std::size_t>(f)])
+      area_mark_[static_cast<std::size_t>(v)] = 0;
+  for (const auto f : pending)
+    for (const auto v : faces_[static_cast<std::size_t>(f)])
+      area_mark_[static_cast<std::size_t>(v)] = 0;
 
   // Pieces left without nodes leave the world.
   for (auto& piece : pieces_)
@@ -890,7 +968,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       remove_(piece->body.get());
       piece.reset();
     }
-  relink_.clear();
+  clear_kept();
   bend_dirty_.clear();
   sec.insert += seconds_since(clock);
 }

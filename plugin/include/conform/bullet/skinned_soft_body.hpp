@@ -93,9 +93,10 @@ struct ApplyStats {
   std::int32_t detached_nodes = 0;  // vertices left without faces, taken out of Bullet
   std::int32_t removed_bending = 0, added_bending = 0;
   std::int32_t searched_vertices = 0;  // visited by the split search
-  /// Where the wall-clock time of the last cut / drill / tear step / apply went, s. The mesh
-  /// side (sync of the simulated positions, computing the change, applying it to the mesh)
-  /// and the plugin's own mirror of it into Bullet, by phase.
+  /// Where the time of the last cut / drill / tear step / apply went, s (CPU time of the
+  /// calling thread): the sync of the simulated positions into the mesh, the mesh side
+  /// (computing the change and applying it to the mesh, in core), and the plugin's own mirror
+  /// of it into Bullet, by phase.
   struct Seconds {
     double sync = 0;      // simulated positions → mesh().current
     double mesh = 0;      // computing the change and applying it to the mesh (core)
@@ -264,6 +265,13 @@ class SkinnedSoftBody {
   // Links removed during one change whose link may come back: (a, b, c, d, rest), where (a, b)
   // is the key edge and (c, d) the end vertices (equal to (a, b) for an edge link).
   std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, double>> relink_;
+  mesh::EdgeMap relink_edge_, relink_bend_;  // key edge → index in relink_
+  void keep_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d, double rest,
+                 bool bending);
+  double kept_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
+                   bool bending) const;
+  void clear_kept();
+  std::vector<std::uint8_t> area_mark_, seed_mark_;  // per vertex scratch, 0 between changes
   // Edges whose bending link may have to be made again at the end of a change.
   std::vector<std::pair<std::int32_t, std::int32_t>> bend_dirty_;
 
