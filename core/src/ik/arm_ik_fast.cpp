@@ -12,6 +12,19 @@
 #include "conform/ik/kernel.hpp"
 #include "conform/ik/limits.hpp"
 
+// One clone per instruction set, picked at load time (the default build targets baseline
+// x86-64: SSE2, 4 floats wide, two-operand instructions). The batch gets AVX-512 (16 floats)
+// and AVX2 clones; the scalar common path an AVX2 one (three-operand instructions: none of the
+// register copies that two-operand SSE needs).
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(CONFORM_NO_CLONES)
+#define CONFORM_IK_CLONES \
+  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
+#define CONFORM_IK_SCALAR_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define CONFORM_IK_CLONES
+#define CONFORM_IK_SCALAR_CLONES
+#endif
+
 namespace conform::ik {
 
 std::string to_string(Status s) {
@@ -94,13 +107,64 @@ template <class T>
   return detail::solve_kernel_dir<T, detail::Path::kScalar>(c, p.x(), p.y(), p.z(), sw.c, sw.s);
 }
 
+// The common case, writing the solution in place.
+template <class T>
+[[gnu::always_inline]] inline void common_angle_body(const detail::KernelConstants<T>& c, T px,
+                                                     T py, T pz, T phi, Solution<T>& s) {
+  const detail::SinCos<T> sc = detail::sincos_scalar(phi);
+  s = to_solution(
+      detail::solve_kernel_cs<T, detail::Path::kCommon>(c, px, py, pz, sc.c, sc.s, true));
+}
+template <class T>
+[[gnu::always_inline]] inline void common_dir_body(const detail::KernelConstants<T>& c, T px, T py,
+                                                   T pz, T cphi, T sphi, Solution<T>& s) {
+  s = to_solution(
+      detail::solve_kernel_cs<T, detail::Path::kCommon>(c, px, py, pz, cphi, sphi, true));
+}
+[[gnu::noinline]] CONFORM_IK_SCALAR_CLONES void common_angle(
+    const detail::KernelConstants<float>& c, float px, float py, float pz, float phi,
+    Solution<float>& s) {
+  common_angle_body(c, px, py, pz, phi, s);
+}
+[[gnu::noinline]] CONFORM_IK_SCALAR_CLONES void common_angle(
+    const detail::KernelConstants<double>& c, double px, double py, double pz, double phi,
+    Solution<double>& s) {
+  common_angle_body(c, px, py, pz, phi, s);
+}
+[[gnu::noinline]] CONFORM_IK_SCALAR_CLONES void common_dir(const detail::KernelConstants<float>& c,
+                                                           float px, float py, float pz, float cphi,
+                                                           float sphi, Solution<float>& s) {
+  common_dir_body(c, px, py, pz, cphi, sphi, s);
+}
+[[gnu::noinline]] CONFORM_IK_SCALAR_CLONES void common_dir(const detail::KernelConstants<double>& c,
+                                                           double px, double py, double pz,
+                                                           double cphi, double sphi,
+                                                           Solution<double>& s) {
+  common_dir_body(c, px, py, pz, cphi, sphi, s);
+}
+
+template <class T>
+[[gnu::always_inline]] inline bool angle_is_common(const detail::KernelConstants<T>& c,
+                                                   const Vec3<T>& p, T phi) {
+  return common_case(c, p.x(), p.y(), p.z()) & (phi <= T(kMaxSwivel)) & (phi >= T(-kMaxSwivel));
+}
+template <class T>
+[[gnu::always_inline]] inline bool dir_is_common(const detail::KernelConstants<T>& c,
+                                                 const Vec3<T>& p, SwivelCosSin<T> sw) {
+  // The pair is used as given when it is unit to a few ulps, else normalized (out of line).
+  const T q = sw.c * sw.c + sw.s * sw.s;
+  const bool unit = std::abs(q - T(1)) <= T(8) * std::numeric_limits<T>::epsilon();
+  return common_case(c, p.x(), p.y(), p.z()) & unit;
+}
+
+// As KernelResult (for the shoulder cone's probes).
 template <class T>
 [[gnu::always_inline]] inline detail::KernelResult<T> kernel_angle(
     const detail::KernelConstants<T>& c, const Vec3<T>& p, T phi) {
-  const T px = p.x(), py = p.y(), pz = p.z();
-  if (common_case(c, px, py, pz) & (phi <= T(kMaxSwivel)) & (phi >= T(-kMaxSwivel))) [[likely]] {
+  if (angle_is_common(c, p, phi)) [[likely]] {
     const detail::SinCos<T> sc = detail::sincos_scalar(phi);
-    return detail::solve_kernel_cs<T, detail::Path::kCommon>(c, px, py, pz, sc.c, sc.s, true);
+    return detail::solve_kernel_cs<T, detail::Path::kCommon>(c, p.x(), p.y(), p.z(), sc.c, sc.s,
+                                                             true);
   }
   return rare_angle(c, p, phi);
 }
@@ -108,12 +172,9 @@ template <class T>
 template <class T>
 [[gnu::always_inline]] inline detail::KernelResult<T> kernel_dir(
     const detail::KernelConstants<T>& c, const Vec3<T>& p, SwivelCosSin<T> sw) {
-  const T px = p.x(), py = p.y(), pz = p.z();
-  const T q = sw.c * sw.c + sw.s * sw.s;
-  // The pair is used as given when it is unit to a few ulps, else normalized (out of line).
-  const bool unit = std::abs(q - T(1)) <= T(8) * std::numeric_limits<T>::epsilon();
-  if (common_case(c, px, py, pz) & unit) [[likely]] {
-    return detail::solve_kernel_cs<T, detail::Path::kCommon>(c, px, py, pz, sw.c, sw.s, true);
+  if (dir_is_common(c, p, sw)) [[likely]] {
+    return detail::solve_kernel_cs<T, detail::Path::kCommon>(c, p.x(), p.y(), p.z(), sw.c, sw.s,
+                                                             true);
   }
   return rare_dir(c, p, sw);
 }
@@ -139,18 +200,34 @@ Solution<T> solve_cone(const Arm<T>& arm, T swivel, Run&& run) {
 }
 
 template <class T>
-Solution<T> solve_angle(const Arm<T>& arm, const detail::KernelConstants<T>& c,
-                        const Vec3<T>& target, T swivel) {
-  if (!arm.limits.has_cone()) [[likely]]
-    return to_solution(kernel_angle(c, target, swivel));
+[[gnu::always_inline]] inline Solution<T> solve_angle(const Arm<T>& arm,
+                                                      const detail::KernelConstants<T>& c,
+                                                      const Vec3<T>& target, T swivel) {
+  if (!arm.limits.has_cone()) [[likely]] {
+    Solution<T> s;
+    if (angle_is_common(c, target, swivel)) [[likely]] {
+      common_angle(c, target.x(), target.y(), target.z(), swivel, s);
+      return s;
+    }
+    s = to_solution(rare_angle(c, target, swivel));
+    return s;
+  }
   return solve_cone(arm, swivel, [&](T phi) { return kernel_angle(c, target, phi); });
 }
 
 template <class T>
-Solution<T> solve_dir(const Arm<T>& arm, const detail::KernelConstants<T>& c, const Vec3<T>& target,
-                      SwivelCosSin<T> swivel) {
-  if (!arm.limits.has_cone()) [[likely]]
-    return to_solution(kernel_dir(c, target, swivel));
+[[gnu::always_inline]] inline Solution<T> solve_dir(const Arm<T>& arm,
+                                                    const detail::KernelConstants<T>& c,
+                                                    const Vec3<T>& target, SwivelCosSin<T> swivel) {
+  if (!arm.limits.has_cone()) [[likely]] {
+    Solution<T> s;
+    if (dir_is_common(c, target, swivel)) [[likely]] {
+      common_dir(c, target.x(), target.y(), target.z(), swivel.c, swivel.s, s);
+      return s;
+    }
+    s = to_solution(rare_dir(c, target, swivel));
+    return s;
+  }
   // The cone works on angles. An invalid pair stays invalid (the kernel reports it).
   const detail::KernelResult<T> probe = kernel_dir(c, target, swivel);
   if (probe.status & detail::kBitInvalid) return to_solution(probe);
@@ -275,15 +352,6 @@ template <class T>
     st[i] = r.status;
   }
 }
-
-// One clone per instruction set, picked at load time (the default build targets baseline
-// x86-64, whose SSE2 is 4 floats wide; AVX-512 machines get 16).
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__) && !defined(CONFORM_NO_CLONES)
-#define CONFORM_IK_CLONES \
-  __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default")))
-#else
-#define CONFORM_IK_CLONES
-#endif
 
 CONFORM_IK_CLONES void run_range(const detail::KernelConstants<float>& c,
                                  const BatchPointers<float>& p, std::ptrdiff_t begin,

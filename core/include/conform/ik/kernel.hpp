@@ -263,20 +263,41 @@ struct ScalarOps {
   }
 };
 #if defined(__SSE2__)
+// A scalar as the low lane of a vector register, the other lanes left as they are (unused):
+// _mm_set_sd would clear them with one more instruction per use. GCC takes the empty asm
+// with a tied operand as a free re-interpretation of the register.
+[[gnu::always_inline]] inline __m128d low_lane(double x) {
+#if defined(__GNUC__) && !defined(__clang__)
+  __m128d v;
+  __asm__("" : "=x"(v) : "0"(x));
+  return v;
+#else
+  return _mm_set_sd(x);
+#endif
+}
+[[gnu::always_inline]] inline __m128 low_lane(float x) {
+#if defined(__GNUC__) && !defined(__clang__)
+  __m128 v;
+  __asm__("" : "=x"(v) : "0"(x));
+  return v;
+#else
+  return _mm_set_ss(x);
+#endif
+}
+
 template <>
 struct ScalarOps<double> {
   struct Mask {
     __m128d m;
   };
   [[gnu::always_inline]] static Mask less(double a, double b) {
-    return {_mm_cmplt_sd(_mm_set_sd(a), _mm_set_sd(b))};
+    return {_mm_cmplt_sd(low_lane(a), low_lane(b))};
   }
   [[gnu::always_inline]] static double pick(Mask m, double a, double b) {
-    return _mm_cvtsd_f64(
-        _mm_or_pd(_mm_and_pd(m.m, _mm_set_sd(a)), _mm_andnot_pd(m.m, _mm_set_sd(b))));
+    return _mm_cvtsd_f64(_mm_or_pd(_mm_and_pd(m.m, low_lane(a)), _mm_andnot_pd(m.m, low_lane(b))));
   }
   [[gnu::always_inline]] static double sqrt(double x) {
-    const __m128d v = _mm_set_sd(x);
+    const __m128d v = low_lane(x);
     return _mm_cvtsd_f64(_mm_sqrt_sd(v, v));
   }
   [[gnu::always_inline]] static double rsqrt(double x) { return 1.0 / sqrt(x); }
@@ -295,14 +316,13 @@ struct ScalarOps<float> {
     __m128 m;
   };
   [[gnu::always_inline]] static Mask less(float a, float b) {
-    return {_mm_cmplt_ss(_mm_set_ss(a), _mm_set_ss(b))};
+    return {_mm_cmplt_ss(low_lane(a), low_lane(b))};
   }
   [[gnu::always_inline]] static float pick(Mask m, float a, float b) {
-    return _mm_cvtss_f32(
-        _mm_or_ps(_mm_and_ps(m.m, _mm_set_ss(a)), _mm_andnot_ps(m.m, _mm_set_ss(b))));
+    return _mm_cvtss_f32(_mm_or_ps(_mm_and_ps(m.m, low_lane(a)), _mm_andnot_ps(m.m, low_lane(b))));
   }
   [[gnu::always_inline]] static float sqrt(float x) {
-    return _mm_cvtss_f32(_mm_sqrt_ss(_mm_set_ss(x)));
+    return _mm_cvtss_f32(_mm_sqrt_ss(low_lane(x)));
   }
   [[gnu::always_inline]] static float rsqrt(float x) { return 1.0f / sqrt(x); }
   [[gnu::always_inline]] static Root<float> root(float x) {
