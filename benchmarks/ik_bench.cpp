@@ -12,10 +12,13 @@
 //   solver_cs    ArmSolver::solve(target, {cos φ, sin φ}) with the pair precomputed per target
 //   latency      ArmSolver::solve(target, φ) with each target depending on the previous result
 //                (no overlap between consecutive solves: the time of one solve, start to end)
+//   latency_q12  the same for the previous formulation
 //
 // Counters: solves_per_s (rate), x_paper_cpu and x_fpga (that rate over the paper's), and
 // x_readable (over the readable version of the same precision, measured earlier in this run).
-// A table of the medians over repetitions is printed at the end.
+// A table of the medians over repetitions is printed at the end: solves/s by wall and CPU time,
+// ns per solve, and the ratios over the readable version, over the previous formulation
+// (scalar_q12; latency_q12 for the latency row), over the paper's CPU and its FPGA.
 #include <benchmark/benchmark.h>
 #include <time.h>
 
@@ -151,7 +154,7 @@ template <class T>
   return s;
 }
 
-enum class Scalar { kQ12, kFree, kSolver, kSolverCosSin, kLatency };
+enum class Scalar { kQ12, kFree, kSolver, kSolverCosSin, kLatency, kLatencyQ12 };
 
 const char* scalar_name(Scalar v) {
   switch (v) {
@@ -165,6 +168,8 @@ const char* scalar_name(Scalar v) {
       return "solver_cs";
     case Scalar::kLatency:
       return "latency";
+    case Scalar::kLatencyQ12:
+      return "latency_q12";
   }
   return "?";
 }
@@ -185,7 +190,7 @@ void BM_Scalar(benchmark::State& state) {
   for (auto _ : state) {
     const ik::Vec3<T> target(d.x[i] + carry, d.y[i], d.z[i]);
     ik::Solution<T> s;
-    if constexpr (kVariant == Scalar::kQ12) {
+    if constexpr (kVariant == Scalar::kQ12 || kVariant == Scalar::kLatencyQ12) {
       s = solve_q12(arm, target, d.phi[i]);
     } else if constexpr (kVariant == Scalar::kFree) {
       s = ik::solve(arm, target, d.phi[i]);
@@ -194,7 +199,7 @@ void BM_Scalar(benchmark::State& state) {
     } else {
       s = solver.solve(target, d.phi[i]);
     }
-    if constexpr (kVariant == Scalar::kLatency) {
+    if constexpr (kVariant == Scalar::kLatency || kVariant == Scalar::kLatencyQ12) {
       carry = zero * (s.qs.w() + s.qs.x() + s.qs.y() + s.qs.z());
     } else {
       benchmark::DoNotOptimize(s);
@@ -258,6 +263,8 @@ BENCHMARK(BM_Scalar<float, Scalar::kSolverCosSin>)->Name("BM_ArmSolverCosSin/flo
 BENCHMARK(BM_Scalar<double, Scalar::kSolverCosSin>)->Name("BM_ArmSolverCosSin/double");
 BENCHMARK(BM_Scalar<float, Scalar::kLatency>)->Name("BM_ArmSolverLatency/float");
 BENCHMARK(BM_Scalar<double, Scalar::kLatency>)->Name("BM_ArmSolverLatency/double");
+BENCHMARK(BM_Scalar<float, Scalar::kLatencyQ12>)->Name("BM_ScalarQ12Latency/float");
+BENCHMARK(BM_Scalar<double, Scalar::kLatencyQ12>)->Name("BM_ScalarQ12Latency/double");
 BENCHMARK(BM_Batch<float>)
     ->Name("BM_Batch/float")
     ->ArgNames({"n", "threads"})
@@ -293,7 +300,8 @@ void print_table() {
     };
     std::printf("  %-32s %11.4g %11.4g %8.1f %8.1f %10.4g %8.3g %9.4g %9.4g\n", name.c_str(),
                 rate.first, rate.second, 1e9 / rate.first, 1e9 / rate.second, over("readable"),
-                over("scalar_q12"), rate.first / kPaperCpu, rate.first / kPaperFpga);
+                over(name.rfind("latency", 0) == 0 ? "latency_q12" : "scalar_q12"),
+                rate.first / kPaperCpu, rate.first / kPaperFpga);
   }
   std::fflush(stdout);
 }
@@ -306,6 +314,8 @@ int main(int argc, char** argv) {
     const std::string base = std::string("BM_ScalarQ12/") + p;
     for (const char* v : {"BM_ScalarFast/", "BM_ArmSolver/", "BM_ArmSolverCosSin/"})
       conform::bench::add_ratio(v + std::string(p), base);
+    conform::bench::add_ratio(std::string("BM_ArmSolverLatency/") + p,
+                              std::string("BM_ScalarQ12Latency/") + p);
   }
   const int rc = conform::bench::run_with_ratios(argc, argv);
   print_table();

@@ -18,8 +18,9 @@
 // Cost per solve: 5 square roots (4 independent ones on the inputs, 1 for Qs) and 3 divisions
 // in the scalar path, about 110 multiplications and additions, and a polynomial sincos of φ
 // unless (cos φ, sin φ) is given (the paper's pipeline takes cos(φ/2), sin(φ/2) as inputs;
-// its Table 4, optimized: 8 roots, 10 divisions). The longest chain has two root+division
-// steps (|Pw|, then Qs); the Q12·Q3 form (kernel_q12.hpp) had four.
+// its Table 4, optimized: 8 roots, 10 divisions). The longest chain has two root steps (|Pw|,
+// then Qs), each with its division alongside on the scalar common path (1/√x = √x·(1/x));
+// the Q12·Q3 form (kernel_q12.hpp) had four root+division steps one after the other.
 // In the vector path there is no division and no std::sqrt: GCC keeps sqrt's errno path (a
 // call per element) unless the whole build uses -fno-math-errno, which would block
 // vectorization; every root and reciprocal there is rsqrt() below (bit-trick seed + Newton,
