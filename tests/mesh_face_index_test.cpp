@@ -221,3 +221,31 @@ TEST(FaceIndex, ManyLocalChangesKeepQueriesExact) {
   EXPECT_EQ(index.validate(m), "");
   expect_same_as_scan(index, m, random_segments(m, 1000, rng), "refined sheet");
 }
+
+TEST(FaceIndex, SlotBookkeepingOfRandomChanges) {
+  // Changes that remove random faces (often at the end of the face list, where apply() pops
+  // and swaps) and put back a random part of them, in random order: the index follows the
+  // slots exactly.
+  std::mt19937 rng(15);
+  SkinnedMesh m = make_icosphere(3);
+  FaceIndex index(m);
+  for (int round = 0; round < 60 && m.face_count() > 40; ++round) {
+    std::vector<std::int32_t> removed;
+    std::uniform_int_distribution<std::int32_t> any(0, m.face_count() - 1);
+    for (int i = 0; i < 12; ++i) removed.push_back(round % 2 ? any(rng) : m.face_count() - 1 - i);
+    std::sort(removed.begin(), removed.end());
+    removed.erase(std::unique(removed.begin(), removed.end()), removed.end());
+    TopologyChange ch;
+    ch.base_vertex_count = m.vertex_count();
+    ch.base_face_count = m.face_count();
+    ch.removed_faces = removed;
+    std::shuffle(removed.begin(), removed.end(), rng);
+    const auto keep = std::uniform_int_distribution<std::size_t>(0, removed.size())(rng);
+    for (std::size_t k = 0; k < keep; ++k)
+      ch.added_faces.push_back(m.faces[static_cast<std::size_t>(removed[k])]);
+    apply(m, ch);
+    index.update(m, ch);
+    ASSERT_EQ(index.validate(m), "") << round;
+  }
+  expect_same_as_scan(index, m, random_segments(m, 1000, rng), "after random removals");
+}

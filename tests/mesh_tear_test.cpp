@@ -7,6 +7,7 @@
 
 #include "conform/cga/versor.hpp"
 #include "conform/mesh/analysis.hpp"
+#include "conform/mesh/face_index.hpp"
 #include "conform/mesh/primitives.hpp"
 #include "conform/mesh/procedural_arm.hpp"
 #include "conform/mesh/tear.hpp"
@@ -220,4 +221,53 @@ TEST(Tear, ReDeformation) {
   // New vertices: exact where their parents share influences; the LBS t(1 − t) term elsewhere.
   EXPECT_LT(worst, 2e-3);
   RecordProperty("worst_new_vertex_error", std::to_string(worst));
+}
+
+TEST(Tear, IndexScanAndTemporaryIndexStartAlike) {
+  // The tear through a kept FaceIndex, a temporary one and the brute-force scan makes the same
+  // changes; the kept index stays in sync (sound, and it answers as the scan does).
+  const SkinnedMesh in = make_arm(1).mesh;
+  std::vector<SkinnedMesh> out;
+  for (int mode = 0; mode < 3; ++mode) {
+    SkinnedMesh m = in;
+    Adjacency adj(m);
+    FaceIndex index(m);
+    TearOptions o;
+    o.search = mode == 2 ? FaceSearch::Scan : FaceSearch::Index;
+    Tear tear = mode == 0 ? Tear(m, adj, index, o) : Tear(m, adj, o);
+    // The first samples miss the arm (the blade stops short of it): no start, no change.
+    for (int i = 0; i < 3; ++i)
+      EXPECT_TRUE(tear.advance({double(i), {0, 0, 0.2}, {0.01, 0.001 * i, 0.2}}).changes.empty());
+    for (int i = 0; i < 60; ++i) {
+      const double z = 0.08 + 0.12 * i / 59.0, a = 0.3 + 0.4 * i / 59.0;
+      tear.advance({double(i + 3), {0, 0, z}, {0.2 * std::cos(a), 0.2 * std::sin(a), z}});
+    }
+    EXPECT_EQ(tear.steps(), 59) << mode << ": " << tear.message();
+    expect_torn(m, in, tear, "mode " + std::to_string(mode));
+    if (mode == 0) {
+      EXPECT_EQ(index.validate(m), "");
+      for (int i = 0; i < 200; ++i) {
+        const double z = 0.01 + 0.6 * i / 199.0, a = 0.1 * i;
+        const Eigen::Vector3d p(0, 0, z), q(0.2 * std::cos(a), 0.2 * std::sin(a), z + 0.01);
+        const auto want = scan_segment_hits(m, p, q);
+        ASSERT_EQ(index.first_hit(m, p, q).face, want.empty() ? -1 : want.front().face) << i;
+      }
+    }
+    out.push_back(std::move(m));
+  }
+  EXPECT_EQ(out[0].faces, out[1].faces);
+  EXPECT_EQ(out[0].faces, out[2].faces);
+  EXPECT_EQ(out[0].current, out[2].current);
+}
+
+TEST(Tear, StartsAtTheBladesFirstHit) {
+  // A blade through both walls of a sphere starts the tear on the wall nearest its end a.
+  SkinnedMesh m = make_icosphere(3);
+  Adjacency adj(m);
+  FaceIndex index(m);
+  Tear tear(m, adj, index);
+  ASSERT_TRUE(tear.advance({0, {0.1, 0.05, 2}, {0.1, 0.05, -2}}).changes.size() == 1);
+  const Eigen::Vector3d s0 = m.current.col(m.vertex_count() - 1);
+  EXPECT_GT(s0.z(), 0.9);
+  EXPECT_EQ(index.validate(m), "");
 }

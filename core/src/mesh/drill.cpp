@@ -120,12 +120,12 @@ std::vector<std::int32_t> rim_loop(const SkinnedMesh& mesh, const Adjacency& adj
   for (std::size_t k = hole.added_begin; k < hole.added_end; ++k)
     for (int e = 0; e < 3; ++e)
       added.insert(ch.added_faces[k][e], ch.added_faces[k][(e + 1) % 3], 1);
-  EdgeMap next;  // (u, 0) → v for the boundary half-edge u → v
+  EdgeMap next;  // (0, u) → v for the boundary half-edge u → v
   std::size_t count = 0;
   std::int32_t start = -1;
   bool simple = true;
   auto boundary = [&](std::int32_t u, std::int32_t v) {
-    simple = simple && next.insert(u, 0, v);
+    simple = simple && next.insert(0, u, v);
     ++count;
     start = u;
   };
@@ -154,7 +154,7 @@ std::vector<std::int32_t> rim_loop(const SkinnedMesh& mesh, const Adjacency& adj
   do {
     if (!(v >= ch.base_vertex_count || side_of(v) == 0)) return {};  // not a rim vertex
     loop.push_back(v);
-    v = next.find(v, 0);
+    v = next.find(0, v);
     if (v < 0) return {};
   } while (v != start && loop.size() <= count);
   if (loop.size() != count) return {};  // more than one loop
@@ -238,13 +238,13 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
     // The strip must only add edges: along the rims the reverse of a boundary half-edge, across
     // the tube edges that do not exist yet.
     EdgeMap in_a;
-    for (auto v : A) in_a.insert(v, 0, 1);
+    for (auto v : A) in_a.insert(0, v, 1);
     bool ok = true;
-    for (auto v : B) ok = ok && in_a.find(v, 0) < 0;
+    for (auto v : B) ok = ok && in_a.find(0, v) < 0;
     for (const Face& f : faces)
       for (int e = 0; e < 3 && ok; ++e) {
         const std::int32_t x = f[e], y = f[(e + 1) % 3];
-        const bool across = (in_a.find(x, 0) >= 0) != (in_a.find(y, 0) >= 0);
+        const bool across = (in_a.find(0, x) >= 0) != (in_a.find(0, y) >= 0);
         ok = adjacency.find(x, y) < 0 && (!across || adjacency.find(y, x) < 0);
       }
     if (!ok) {
@@ -306,25 +306,25 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
   std::vector<Patch> patches;
   auto walk = [&]() {
     patches.clear();
-    EdgeMap seen;  // (face, 0) → its patch
+    EdgeMap seen;  // (0, face) → its patch (keys (0, x): EdgeMap hashes u poorly)
     for (auto s : seeds) {
-      if (seen.find(s, 0) >= 0) continue;
+      if (seen.find(0, s) >= 0) continue;
       const auto id = static_cast<std::int32_t>(patches.size());
       std::vector<std::int32_t> patch;
       std::deque<std::int32_t> queue{s};
-      seen.insert(s, 0, id);
+      seen.insert(0, s, id);
       while (!queue.empty()) {
         const std::int32_t f = queue.front();
         queue.pop_front();
         patch.push_back(f);
         for (int k = 0; k < 3; ++k) {
           const std::int32_t g = adjacency.neighbor(f, k);
-          if (g < 0 || seen.find(g, 0) >= 0) continue;
+          if (g < 0 || seen.find(0, g) >= 0) continue;
           const Face& t = mesh.faces[static_cast<std::size_t>(g)];
           bool near = false;
           for (int e = 0; e < 3 && !near; ++e) near = edge_near(t[e], t[(e + 1) % 3]);
           if (!near) continue;
-          seen.insert(g, 0, id);
+          seen.insert(0, g, id);
           queue.push_back(g);
         }
       }
@@ -335,7 +335,7 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     }
     // Where the axis pierces each patch first, and whether it enters the surface there.
     for (auto s : seeds) {
-      Patch& p = patches[static_cast<std::size_t>(seen.find(s, 0))];
+      Patch& p = patches[static_cast<std::size_t>(seen.find(0, s))];
       const double at = pierced(s);
       if (at < 0 || at >= p.t) continue;
       p.t = at;
@@ -411,12 +411,12 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
   }
 
   // Classify the patches' vertices: +1 outside, −1 inside, 0 on the cylinder (snapped).
-  EdgeMap side;  // (vertex, 0) → side + 1
-  auto side_of = [&](std::int32_t v) { return side.find(v, 0) - 1; };
+  EdgeMap side;  // (0, vertex) → side + 1
+  auto side_of = [&](std::int32_t v) { return side.find(0, v) - 1; };
   for (const auto& hole : patches)
     for (auto f : hole.faces)
       for (auto v : mesh.faces[static_cast<std::size_t>(f)])
-        if (side.find(v, 0) < 0) side.insert(v, 0, inside(v) ? 0 : 2);
+        if (side.find(0, v) < 0) side.insert(0, v, inside(v) ? 0 : 2);
   const std::int32_t nv0 = mesh.vertex_count();
   TopologyChange ch;
   ch.base_vertex_count = nv0;
@@ -436,9 +436,9 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
         if (sa * sb >= 0) continue;
         const double tt = crossing_t(a, b);
         if (tt < options.snap_fraction)
-          side.insert(a, 0, 1, true), ++result.snapped_rim_vertices;
+          side.insert(0, a, 1, true), ++result.snapped_rim_vertices;
         else if (tt > 1 - options.snap_fraction)
-          side.insert(b, 0, 1, true), ++result.snapped_rim_vertices;
+          side.insert(0, b, 1, true), ++result.snapped_rim_vertices;
       }
     }
   EdgeMap xmap;

@@ -6,23 +6,13 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "conform/mesh/adjacency.hpp"
+
 namespace conform::mesh {
 
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-
-// Floats rounded outward, so that a float box always contains the doubles it was made from.
-float round_down(double x) {
-  float f = static_cast<float>(x);
-  if (static_cast<double>(f) > x) f = std::nextafter(f, -kInf);
-  return f;
-}
-float round_up(double x) {
-  float f = static_cast<float>(x);
-  if (static_cast<double>(f) < x) f = std::nextafter(f, kInf);
-  return f;
-}
 
 bool less_hit(const SegmentHit& a, const SegmentHit& b) {
   return a.t < b.t || (a.t == b.t && a.face < b.face);
@@ -67,8 +57,9 @@ std::vector<SegmentHit> scan_segment_hits(const SkinnedMesh& mesh, const Eigen::
 
 namespace {
 
-// A box from double bounds: padded by 1e−6 of its largest extent and 1e−9 of its largest
-// coordinate (so that rounding in the slab test never rejects a point of a face), rounded out.
+// A box from double bounds, padded by 1e−6 of its largest extent plus its largest coordinate:
+// more than a float's rounding (2^−24 relative), so the float box still holds the doubles, and
+// enough that rounding in the slab test never rejects a point of a face.
 template <class Box>
 Box make_box(const double lo[3], const double hi[3]) {
   Box b;
@@ -81,10 +72,10 @@ Box make_box(const double lo[3], const double hi[3]) {
     ext = std::max(ext, hi[k] - lo[k]);
     mag = std::max({mag, std::abs(lo[k]), std::abs(hi[k])});
   }
-  const double pad = 1e-6 * ext + 1e-9 * mag;
+  const double pad = 1e-6 * (ext + mag);
   for (int k = 0; k < 3; ++k) {
-    b.lo[k] = round_down(lo[k] - pad);
-    b.hi[k] = round_up(hi[k] + pad);
+    b.lo[k] = static_cast<float>(lo[k] - pad);
+    b.hi[k] = static_cast<float>(hi[k] + pad);
   }
   return b;
 }
@@ -194,15 +185,41 @@ void FaceIndex::build(const SkinnedMesh& mesh) {
   leaf_of_.assign(static_cast<std::size_t>(nf), -1);
   fitted_ = true;
   if (nf == 0) return;
-  std::vector<std::int32_t> order(static_cast<std::size_t>(nf));
-  std::iota(order.begin(), order.end(), 0);
-  std::vector<std::array<float, 3>> centroid(static_cast<std::size_t>(nf));
+  // Faces in Morton order of their centroids (21 bits per axis over the centroids' box), then
+  // a balanced tree over that order by halving: spatially coherent leaves at the cost of a sort.
+  std::vector<Eigen::Vector3d> centroid(static_cast<std::size_t>(nf));
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
   for (std::int32_t f = 0; f < nf; ++f) {
     const Face& t = mesh.faces[static_cast<std::size_t>(f)];
-    for (int k = 0; k < 3; ++k)
-      centroid[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)] = static_cast<float>(
-          (mesh.current(k, t[0]) + mesh.current(k, t[1]) + mesh.current(k, t[2])) / 3);
+    const Eigen::Vector3d c =
+        (mesh.current.col(t[0]) + mesh.current.col(t[1]) + mesh.current.col(t[2])) / 3;
+    centroid[static_cast<std::size_t>(f)] = c;
+    lo = lo.cwiseMin(c);
+    hi = hi.cwiseMax(c);
   }
+  const double extent = (hi - lo).maxCoeff();
+  const double scale = extent > 0 ? (double(1 << 21) - 1) / extent : 0;
+  auto spread = [](std::uint64_t x) {  // 21 bits to every third of 63
+    x &= 0x1fffff;
+    x = (x | x << 32) & 0x1f00000000ffffull;
+    x = (x | x << 16) & 0x1f0000ff0000ffull;
+    x = (x | x << 8) & 0x100f00f00f00f00full;
+    x = (x | x << 4) & 0x10c30c30c30c30c3ull;
+    x = (x | x << 2) & 0x1249249249249249ull;
+    return x;
+  };
+  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(static_cast<std::size_t>(nf));
+  for (std::int32_t f = 0; f < nf; ++f) {
+    const Eigen::Vector3d q = (centroid[static_cast<std::size_t>(f)] - lo) * scale;
+    std::uint64_t code = 0;
+    for (int k = 0; k < 3; ++k) {
+      const double x = std::isfinite(q[k]) ? std::clamp(q[k], 0.0, double(1 << 21) - 1) : 0;
+      code |= spread(static_cast<std::uint64_t>(x)) << k;
+    }
+    keyed[static_cast<std::size_t>(f)] = {code, f};
+  }
+  std::sort(keyed.begin(), keyed.end());
   const std::size_t leaves = static_cast<std::size_t>(nf) / kLeafBuild + 1;
   nodes_.reserve(2 * leaves + 16);
   items_.reserve(kLeafCapacity * leaves + 64);
@@ -221,31 +238,13 @@ void FaceIndex::build(const SkinnedMesh& mesh) {
       leaf.first = first;
       leaf.count = n;
       for (std::int32_t i = 0; i < n; ++i) {
-        const std::int32_t f = order[static_cast<std::size_t>(task.begin + i)];
+        const std::int32_t f = keyed[static_cast<std::size_t>(task.begin + i)].second;
         items_[static_cast<std::size_t>(first + i)] = f;
         leaf_of_[static_cast<std::size_t>(f)] = task.node;
       }
       continue;
     }
-    float lo[3] = {kInf, kInf, kInf}, hi[3] = {-kInf, -kInf, -kInf};
-    for (std::int32_t i = task.begin; i < task.end; ++i) {
-      const auto& c = centroid[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
-      for (int k = 0; k < 3; ++k) {
-        lo[k] = std::min(lo[k], c[static_cast<std::size_t>(k)]);
-        hi[k] = std::max(hi[k], c[static_cast<std::size_t>(k)]);
-      }
-    }
-    int axis = 0;
-    for (int k = 1; k < 3; ++k)
-      if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
     const std::int32_t mid = task.begin + n / 2;
-    std::nth_element(
-        order.begin() + task.begin, order.begin() + mid, order.begin() + task.end,
-        [&](std::int32_t a, std::int32_t b) {
-          const float ca = centroid[static_cast<std::size_t>(a)][static_cast<std::size_t>(axis)],
-                      cb = centroid[static_cast<std::size_t>(b)][static_cast<std::size_t>(axis)];
-          return ca < cb || (ca == cb && a < b);
-        });
     const auto child = static_cast<std::int32_t>(nodes_.size());
     nodes_[static_cast<std::size_t>(task.node)].child = child;
     Node c;
@@ -273,19 +272,27 @@ void FaceIndex::refit(const SkinnedMesh& mesh) {
 }
 
 void FaceIndex::grow_up(std::int32_t n, const Box& box) {
-  for (; n >= 0; n = nodes_[static_cast<std::size_t>(n)].parent)
-    grow(nodes_[static_cast<std::size_t>(n)].box, box);
+  // Boxes nest, so the first ancestor that already holds `box` ends the climb.
+  for (; n >= 0; n = nodes_[static_cast<std::size_t>(n)].parent) {
+    Box& b = nodes_[static_cast<std::size_t>(n)].box;
+    if (contains(b, box)) break;
+    grow(b, box);
+  }
 }
 
-void FaceIndex::insert(const SkinnedMesh& mesh, std::int32_t f) {
-  const Box fb = face_box(mesh, f);
+void FaceIndex::insert(const SkinnedMesh& mesh, std::int32_t f, const Box& fb, std::int32_t near) {
   if (nodes_.empty()) {
     Node root;
     root.box = fb;
     root.first = new_leaf_block();
     nodes_.push_back(root);
+    near = 0;
   }
-  std::int32_t n = 0;
+  // From the hint up to the first box that already holds the face (its ancestors do too),
+  // then down where the boxes grow least.
+  std::int32_t n = near < 0 ? 0 : near;
+  while (n > 0 && !contains(nodes_[static_cast<std::size_t>(n)].box, fb))
+    n = nodes_[static_cast<std::size_t>(n)].parent;
   for (;;) {
     Node& node = nodes_[static_cast<std::size_t>(n)];
     grow(node.box, fb);
@@ -398,19 +405,46 @@ void FaceIndex::update(const SkinnedMesh& mesh, const TopologyChange& change) {
   if (change.base_face_count != face_count() || final_count != mesh.face_count())
     throw std::invalid_argument(
         "FaceIndex::update: the change was not computed for the indexed mesh (apply it first)");
-  // The same slot order as apply(): refilled slots, appended faces, then swap-with-last.
-  for (std::size_t k = 0; k < filled; ++k) erase(removed[k]);
-  for (std::size_t k = 0; k < filled; ++k) insert(mesh, removed[k]);
-  for (std::size_t k = filled; k < added.size(); ++k) {
-    leaf_of_.push_back(-1);
-    insert(mesh, static_cast<std::int32_t>(leaf_of_.size()) - 1);
+  // Faces are tracked by slot. The removed faces leave first; then the slot bookkeeping of
+  // apply() is replayed (refilled slots, appended slots, then swap-with-last, where a moved
+  // face keeps its leaf under its new slot), and only then do the added faces enter, at their
+  // final slots, so that their positions are read from the changed mesh.
+  const std::size_t nr = removed.size(), na = added.size();
+  std::vector<std::int32_t> old_leaf(nr);
+  for (std::size_t j = 0; j < nr; ++j) {
+    old_leaf[j] = leaf_of_[static_cast<std::size_t>(removed[j])];
+    erase(removed[j]);
   }
-  for (std::size_t k = removed.size(); k-- > filled;) {
+  std::vector<std::int32_t> slot_of(na);
+  EdgeMap holder;  // (0, slot) → the added face in it, for refilled slots
+  for (std::size_t k = 0; k < filled; ++k) {
+    slot_of[k] = removed[k];
+    holder.insert(0, removed[k], static_cast<std::int32_t>(k));
+  }
+  for (std::size_t k = filled; k < na; ++k) {
+    slot_of[k] = static_cast<std::int32_t>(leaf_of_.size());
+    leaf_of_.push_back(-1);
+  }
+  for (std::size_t k = nr; k-- > filled;) {
     const std::int32_t slot = removed[k];
     const std::int32_t last = face_count() - 1;
-    erase(slot);
-    if (slot != last) rename(last, slot);
+    if (slot != last) {
+      const std::int32_t h = holder.find(0, last);
+      if (h >= 0) {
+        slot_of[static_cast<std::size_t>(h)] = slot;
+        holder.insert(0, slot, h, true);
+      } else {
+        rename(last, slot);
+      }
+    }
     leaf_of_.pop_back();
+  }
+  // The operations list added faces in the order of the faces they replace, so the k-th added
+  // face most likely lies where removed face k·R/A lay: it enters the tree from that face's
+  // leaf (and stays there when the leaf's box holds it).
+  for (std::size_t k = 0; k < na; ++k) {
+    const std::int32_t near = nr == 0 ? 0 : old_leaf[k * nr / na];
+    insert(mesh, slot_of[k], face_box(mesh, slot_of[k]), near);
   }
 }
 

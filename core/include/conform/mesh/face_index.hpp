@@ -8,8 +8,8 @@
 // refit after a motion is one bottom-up pass that never changes its structure (a grid has to
 // re-bin every face, and its cell size and extent go stale as the mesh moves or deforms), and
 // faces can be inserted and removed locally. Leaves hold up to 8 faces (4 after a build); boxes
-// are floats rounded outward and padded, so a box test never rejects a face that the exact
-// (double) segment–triangle test accepts.
+// are floats padded by more than their rounding, so a box test never rejects a face that the
+// exact (double) segment–triangle test accepts.
 //
 // Keeping the index in sync (the caller's duty, except where noted):
 //   - build(mesh) once per mesh state (O(F log F));
@@ -122,7 +122,7 @@ class FaceIndex {
   Box face_box(const SkinnedMesh& mesh, std::int32_t f) const;
   void fit_leaf(const SkinnedMesh& mesh, std::int32_t n);
   std::int32_t new_leaf_block();
-  void insert(const SkinnedMesh& mesh, std::int32_t f);
+  void insert(const SkinnedMesh& mesh, std::int32_t f, const Box& box, std::int32_t near);
   void erase(std::int32_t f);
   void rename(std::int32_t from, std::int32_t to);
   void split_leaf(const SkinnedMesh& mesh, std::int32_t n, std::int32_t extra);
