@@ -673,9 +673,14 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   // groups are complete pieces (no larger than the growing one, up to the turn order); the
   // growing one is the rest of its body, which keeps its btSoftBody unexplored. Only if that
   // group reaches vertices of two bodies (a merge) or of none is it explored to the end.
+  // Each search expands first the vertex nearest to the far end of the changed region (of two
+  // poles of the seeds, the one farther from its own seed): separate clusters of changes (the
+  // two holes of a drill through both walls) meet along a short path instead of by two
+  // growing discs. The order changes only the cost, never which pieces are found.
   struct Search {
-    std::vector<std::int32_t> queue;  // the vertices it labelled, in order
-    std::size_t head = 0;
+    std::vector<std::int32_t> queue;                    // the vertices it labelled
+    std::vector<std::pair<double, std::int32_t>> heap;  // (squared distance to target, vertex)
+    Eigen::Vector3d target;
     std::int32_t root;
   };
   std::vector<Search> searches;
@@ -687,11 +692,34 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     }
     return s;
   };
+  Eigen::Vector3d pole[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (const auto v : seeds) centre += mesh_.current.col(v);
+    if (!seeds.empty()) centre /= double(seeds.size());
+    double far0 = -1, far1 = -1;
+    for (const auto v : seeds) {
+      const double d = (mesh_.current.col(v) - centre).squaredNorm();
+      if (d > far0) far0 = d, pole[0] = mesh_.current.col(v);
+    }
+    for (const auto v : seeds) {
+      const double d = (mesh_.current.col(v) - pole[0]).squaredNorm();
+      if (d > far1) far1 = d, pole[1] = mesh_.current.col(v);
+    }
+  }
+  auto heap_less = [](const std::pair<double, std::int32_t>& x,
+                      const std::pair<double, std::int32_t>& y) { return x.first > y.first; };
   for (const auto v : seeds) {
     const auto i = static_cast<std::size_t>(v);
     if (vertex_faces_[i].empty() || search_label_[i] >= 0) continue;
     search_label_[i] = std::int32_t(searches.size());
-    searches.push_back({{v}, 0, std::int32_t(searches.size())});
+    const Eigen::Vector3d x = mesh_.current.col(v);
+    Search search;
+    search.queue = {v};
+    search.target = (x - pole[0]).squaredNorm() > (x - pole[1]).squaredNorm() ? pole[0] : pole[1];
+    search.heap = {{(x - search.target).squaredNorm(), v}};
+    search.root = std::int32_t(searches.size());
+    searches.push_back(std::move(search));
   }
   std::vector<std::int32_t> active;
   for (std::size_t s = 0; s < searches.size(); ++s) active.push_back(std::int32_t(s));
@@ -725,14 +753,19 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     std::size_t kept = 0;
     for (const auto s : active) {
       auto& search = searches[static_cast<std::size_t>(s)];
-      const std::int32_t u = search.queue[search.head++];
+      std::pop_heap(search.heap.begin(), search.heap.end(), heap_less);
+      const std::int32_t u = search.heap.back().second;
+      search.heap.pop_back();
       std::int32_t rs = root_of(s);
       for (const auto f : vertex_faces_[static_cast<std::size_t>(u)])
         for (const auto w : faces_[static_cast<std::size_t>(f)]) {
           std::int32_t& label = search_label_[static_cast<std::size_t>(w)];
           if (label < 0) {
             label = s;
-            searches[static_cast<std::size_t>(s)].queue.push_back(w);
+            auto& grow = searches[static_cast<std::size_t>(s)];
+            grow.queue.push_back(w);
+            grow.heap.emplace_back((mesh_.current.col(w) - grow.target).squaredNorm(), w);
+            std::push_heap(grow.heap.begin(), grow.heap.end(), heap_less);
             continue;
           }
           const std::int32_t rw = root_of(label);
@@ -746,8 +779,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
           searches[static_cast<std::size_t>(o)].root = r;
           rs = r;
         }
-      const auto& done = searches[static_cast<std::size_t>(s)];
-      if (done.head < done.queue.size())
+      if (!searches[static_cast<std::size_t>(s)].heap.empty())
         active[kept++] = s;
       else if (--pending_in[static_cast<std::size_t>(rs)] == 0)
         --growing;
