@@ -7,6 +7,9 @@
 // conformal (X·Π) and the Euclidean (n·x − d) predicates, in the same run, the paper's figures
 // beside ours as counters.
 //
+// Caps: cap:1 uses the build's best section triangulator (CGAL's constrained Delaunay when
+// found), cap:ear ear clipping with Delaunay flips (cap.hpp).
+//
 // When CMake found CGAL (libcgal-dev), BM_CgalClip times CGAL's
 // Polygon_mesh_processing::clip of the same mesh (as a Surface_mesh, built outside the timing)
 // by the same plane, with clip_volume = cap; the run ends with the ratios CGAL / ours of the
@@ -100,9 +103,16 @@ const Eigen::Vector3d kCutNormal{0.15, 0.1, 1.0}, kCutPoint{0.0, 0.0, 0.42};
 const Plane kCutPlane = Plane::from_normal_point(kCutNormal, kCutPoint);
 
 // The whole operation: compute the change, apply it (keeping the adjacency), label pieces.
-void cut_bench(benchmark::State& state, int faces, bool cap) {
+// cap: 0 none, 1 the best section triangulator of this build (CGAL's constrained Delaunay when
+// found), 2 ear clipping + Delaunay flips.
+void cut_bench(benchmark::State& state, int faces, int cap) {
   const Model& m = model(faces);
-  const CutOptions options{.cap = cap};
+  const CutOptions options{
+      .cap = cap != 0,
+      .cap_triangulator = cap == 2 ? SectionTriangulator::EarClipping : SectionTriangulator::Best};
+  if (cap != 0)
+    state.SetLabel(cap == 2 || !has_cgal_triangulator() ? "ear clipping + flips"
+                                                        : "CGAL constrained Delaunay");
   std::int32_t pieces = 0, capped = 0;
   double total = 0;
   for (auto _ : state) {
@@ -269,11 +279,17 @@ class RatioReporter : public benchmark::ConsoleReporter {
         std::printf("  %-44s / %-40s %8.3f  %s\n", a.c_str(), b.c_str(), ia->second / ib->second,
                     what);
     };
-    for (int faces : kSizes)
+    for (int faces : kSizes) {
+      const std::string size = "/faces:" + std::to_string(faces);
       for (int cap = 0; cap < 2; ++cap) {
-        const std::string tail = "/faces:" + std::to_string(faces) + "/cap:" + std::to_string(cap);
+        const std::string tail = size + "/cap:" + std::to_string(cap);
         ratio("BM_CgalClip" + tail, "BM_Cut" + tail, "(> 1: our cut is faster than CGAL's clip)");
       }
+      ratio("BM_CgalClip" + size + "/cap:1", "BM_Cut" + size + "/cap:ear",
+            "(> 1: our cut, ear-clipped caps, is faster)");
+      ratio("BM_Cut" + size + "/cap:1", "BM_Cut" + size + "/cap:0", "(capped / open)");
+      ratio("BM_Cut" + size + "/cap:ear", "BM_Cut" + size + "/cap:0", "(ear-clipped caps / open)");
+    }
     ratio("BM_Table1_Sub1_Classify/euclidean:0", "BM_Table1_Sub1_Classify/euclidean:1",
           "(CGA / Euclidean predicates)");
     ratio("BM_Table1_Sub2_IntersectTriangulate/euclidean:0",
@@ -293,14 +309,15 @@ void register_all() {
       b->UseManualTime()->Unit(benchmark::kMillisecond);
       if (iterations > 0) b->Iterations(iterations);
     };
-    for (int cap = 0; cap < 2; ++cap) {
-      const std::string tail = size + "/cap:" + std::to_string(cap);
+    for (int cap = 0; cap < 3; ++cap) {
+      const std::string tail = size + (cap == 2 ? "/cap:ear" : "/cap:" + std::to_string(cap));
       fixed(benchmark::RegisterBenchmark(("BM_Cut" + tail).c_str(),
                                          [=](benchmark::State& s) { cut_bench(s, faces, cap); }));
 #if CONFORM_HAVE_CGAL
-      fixed(benchmark::RegisterBenchmark(("BM_CgalClip" + tail).c_str(), [=](benchmark::State& s) {
-        cgal_clip_bench(s, faces, cap);
-      }));
+      if (cap < 2)
+        fixed(benchmark::RegisterBenchmark(
+            ("BM_CgalClip" + tail).c_str(),
+            [=](benchmark::State& s) { cgal_clip_bench(s, faces, cap != 0); }));
 #endif
     }
     fixed(benchmark::RegisterBenchmark(("BM_CutComputeOnly" + size).c_str(),

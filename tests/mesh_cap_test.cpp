@@ -189,6 +189,58 @@ TEST(Section, SideBySideAndDegenerateLoops) {
   }
 }
 
+TEST(Section, EarClippingEndsConstrainedDelaunay) {
+  // An ellipse with an off-centre elliptic hole: after the flips no inner edge has the fourth
+  // point of its two triangles inside the circumcircle of the other three (the empty-circle
+  // property of the constrained Delaunay triangulation), and the smallest angle is CGAL's
+  // (the constrained Delaunay triangulation maximizes it).
+  Loops loops(2);
+  for (int i = 0; i < 62; ++i) {
+    const double a = 2 * M_PI * i / 62;
+    loops[0].emplace_back(0.04 * std::cos(a), 0.03 * std::sin(a));
+    if (i % 2 == 0) loops[1].emplace_back(0.008 + 0.015 * std::cos(a), 0.01 * std::sin(-a));
+  }
+  std::vector<Eigen::Vector2d> all(loops[0]);
+  all.insert(all.end(), loops[1].begin(), loops[1].end());
+  const SectionTriangulation s = triangulate_section(loops, SectionTriangulator::EarClipping);
+  ASSERT_TRUE(s.ok()) << s.problem;
+  EXPECT_EQ(s.triangles.size(), all.size());  // V + 2H − 2 with H = 1
+  auto P = [&](std::int32_t i) { return all[static_cast<std::size_t>(i)]; };
+  auto min_angle_of = [&](const SectionTriangulation& tri) {
+    double m = M_PI;
+    for (const auto& t : tri.triangles)
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Vector2d u = P(t[(k + 1) % 3]) - P(t[k]), w = P(t[(k + 2) % 3]) - P(t[k]);
+        m = std::min(m, std::acos(u.normalized().dot(w.normalized())));
+      }
+    return m;
+  };
+  int violations = 0;
+  const double min_angle = min_angle_of(s);
+  for (const auto& t : s.triangles)
+    for (const auto& o : s.triangles)
+      for (int k = 0; k < 3; ++k)
+        for (int j = 0; j < 3; ++j) {
+          if (t[k] != o[(j + 1) % 3] || t[(k + 1) % 3] != o[j]) continue;  // shared edge
+          const Eigen::Vector2d a = P(t[k]) - P(o[(j + 2) % 3]),
+                                b = P(t[(k + 1) % 3]) - P(o[(j + 2) % 3]),
+                                c = P(t[(k + 2) % 3]) - P(o[(j + 2) % 3]);
+          const double in = a.squaredNorm() * (b.x() * c.y() - b.y() * c.x()) -
+                            b.squaredNorm() * (a.x() * c.y() - a.y() * c.x()) +
+                            c.squaredNorm() * (a.x() * b.y() - a.y() * b.x());
+          violations += in > 1e-12 * std::pow(0.04, 4);
+        }
+  EXPECT_EQ(violations, 0);
+  if (has_cgal_triangulator()) {
+    const SectionTriangulation c =
+        triangulate_section(loops, SectionTriangulator::ConstrainedDelaunay);
+    ASSERT_TRUE(c.ok()) << c.problem;
+    EXPECT_EQ(c.triangles.size(), s.triangles.size());
+    EXPECT_NEAR(min_angle, min_angle_of(c), 1e-9);
+  }
+  RecordProperty("min_angle_degrees", std::to_string(min_angle * 180 / M_PI));
+}
+
 TEST(CapNested, HollowTubeCutAcross) {
   const SkinnedMesh in = thick_tube();
   ASSERT_TRUE(check_mesh(in).closed());

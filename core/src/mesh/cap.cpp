@@ -1,5 +1,7 @@
 #include "conform/mesh/cap.hpp"
 
+#include "conform/mesh/adjacency.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -48,10 +50,14 @@ bool ear_clip(const Pts& p, std::vector<std::int32_t> idx,
   for (auto i : idx) scale = std::max(scale, P(i).cwiseAbs().maxCoeff());
   const double eps = 1e-14 * scale * scale;
   const std::size_t first = out.size();
+  // Round robin: after an ear is clipped the search resumes two vertices on, so that a convex
+  // polygon is cut into halves, quarters, … rather than into a fan (fewer flips afterwards).
+  std::size_t start = 0;
   while (idx.size() > 3) {
     const std::size_t m = idx.size();
     bool clipped = false;
-    for (std::size_t i = 0; i < m && !clipped; ++i) {
+    for (std::size_t step = 0; step < m && !clipped; ++step) {
+      const std::size_t i = (start + step) % m;
       const std::int32_t a = idx[(i + m - 1) % m], b = idx[i], c = idx[(i + 1) % m];
       if (cross(P(a), P(b), P(c)) <= eps) continue;  // reflex or flat: not an ear
       bool blocked = false;
@@ -64,6 +70,7 @@ bool ear_clip(const Pts& p, std::vector<std::int32_t> idx,
       if (blocked) continue;
       out.push_back({a, b, c});
       idx.erase(idx.begin() + static_cast<std::ptrdiff_t>(i));
+      start = i + 1;
       clipped = true;
     }
     if (!clipped) return false;
@@ -158,6 +165,65 @@ bool bridge(const Pts& p, std::vector<std::int32_t>& poly, const std::vector<std
   return true;
 }
 
+// Lawson's flips on the triangles [first, end) of `t`: every edge shared by two triangles whose
+// fourth point lies inside the other's circumcircle is flipped, until none is (or a generous
+// flip budget runs out). Edges used once — the loops — never flip, so the result is the
+// constrained Delaunay triangulation of the region (up to ties among cocircular points).
+void delaunay_flips(const Pts& p, std::vector<std::array<std::int32_t, 3>>& t, std::size_t first) {
+  const std::size_t n = t.size() - first;
+  if (n < 2) return;
+  auto P = [&](std::int32_t i) -> const Eigen::Vector2d& { return p[static_cast<std::size_t>(i)]; };
+  double scale = 0;
+  for (std::size_t i = first; i < t.size(); ++i)
+    for (auto v : t[i]) scale = std::max(scale, P(v).cwiseAbs().maxCoeff());
+  const double eps_area = 1e-14 * scale * scale, eps_circle = 1e-12 * std::pow(scale, 4);
+  EdgeMap where;  // directed edge → 3 · triangle + k
+  where.reserve(3 * n);
+  std::vector<std::int32_t> stack;
+  for (std::size_t i = first; i < t.size(); ++i)
+    for (int k = 0; k < 3; ++k) {
+      const auto code = static_cast<std::int32_t>(3 * i + static_cast<std::size_t>(k));
+      where.insert(t[i][static_cast<std::size_t>(k)], t[i][static_cast<std::size_t>((k + 1) % 3)],
+                   code, true);
+      stack.push_back(code);
+    }
+  auto incircle = [&](std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) {
+    const Eigen::Vector2d u = P(a) - P(d), v = P(b) - P(d), w = P(c) - P(d);
+    return u.squaredNorm() * (v.x() * w.y() - v.y() * w.x()) -
+           v.squaredNorm() * (u.x() * w.y() - u.y() * w.x()) +
+           w.squaredNorm() * (u.x() * v.y() - u.y() * v.x());
+  };
+  std::size_t budget = 20 * n * n + 100;
+  while (!stack.empty() && budget-- > 0) {
+    const std::int32_t code = stack.back();
+    stack.pop_back();
+    const auto i = static_cast<std::size_t>(code / 3);
+    const int k = code % 3;
+    const std::int32_t a = t[i][static_cast<std::size_t>(k)],
+                       b = t[i][static_cast<std::size_t>((k + 1) % 3)],
+                       c = t[i][static_cast<std::size_t>((k + 2) % 3)];
+    if (where.find(a, b) != code) continue;  // stale: this triangle changed since
+    const std::int32_t other = where.find(b, a);
+    if (other < 0) continue;  // a loop edge
+    const auto j = static_cast<std::size_t>(other / 3);
+    const std::int32_t d = t[j][static_cast<std::size_t>((other % 3 + 2) % 3)];
+    if (!(incircle(a, b, c, d) > eps_circle)) continue;
+    // (a, b, c) and (b, a, d) → (a, d, c) and (d, b, c), when both turn counter-clockwise.
+    if (!(cross(P(a), P(d), P(c)) > eps_area) || !(cross(P(d), P(b), P(c)) > eps_area)) continue;
+    where.erase(a, b, code);
+    where.erase(b, a, other);
+    t[i] = {a, d, c};
+    t[j] = {d, b, c};
+    for (const std::size_t x : {i, j})
+      for (int m = 0; m < 3; ++m) {
+        const auto cm = static_cast<std::int32_t>(3 * x + static_cast<std::size_t>(m));
+        where.insert(t[x][static_cast<std::size_t>(m)], t[x][static_cast<std::size_t>((m + 1) % 3)],
+                     cm, true);
+        stack.push_back(cm);
+      }
+  }
+}
+
 bool ear_clip_section(const std::vector<Pts>& loops, SectionTriangulation& out) {
   Pts p;
   std::vector<std::vector<std::int32_t>> idx(loops.size());
@@ -209,6 +275,7 @@ bool ear_clip_section(const std::vector<Pts>& loops, SectionTriangulation& out) 
       return false;
     }
   }
+  delaunay_flips(p, out.triangles, 0);
   return true;
 }
 

@@ -13,8 +13,11 @@
 //                        when Conform was built with CGAL (libcgal-dev; an optional
 //                        dependency, see has_cgal_triangulator()).
 //   EarClipping          nesting depths by point-in-polygon tests, each hole joined to the
-//                        loop around it by a bridge to a vertex it sees, then ear clipping of
-//                        each merged polygon. Always available; the fallback.
+//                        loop around it by a bridge to a vertex it sees, ear clipping of each
+//                        merged polygon, then Lawson's flips of the inner edges to the
+//                        constrained Delaunay triangulation (floating-point predicates with a
+//                        tolerance). Always available; the fallback, and several times faster
+//                        than CGAL's on the cut's small sections.
 // Neither adds vertices: every triangle joins three loop vertices.
 #pragma once
 
