@@ -179,6 +179,16 @@ SkinnedSoftBody::Piece& SkinnedSoftBody::new_piece() {
 
 void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
   const auto n = static_cast<std::size_t>(m.vertex_count());
+  // Room for edits to grow the per-vertex and per-face tables in place (a reallocation would
+  // copy the whole table during an edit).
+  for (auto* table : {&piece_of_, &node_of_, &detached_slot_, &search_label_})
+    table->reserve(2 * n);
+  for (auto* table : {&area_mark_, &seed_mark_, &pinned_, &kinematic_}) table->reserve(2 * n);
+  mass_.reserve(2 * n);
+  vertex_faces_.reserve(2 * n);
+  faces_.reserve(2 * m.faces.size());
+  face_piece_.reserve(2 * m.faces.size());
+  face_slot_.reserve(2 * m.faces.size());
   faces_ = m.faces;
   face_piece_.assign(faces_.size(), -1);
   face_slot_.assign(faces_.size(), -1);
@@ -198,9 +208,24 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
   }
   const mesh::Pieces labels = mesh::label_pieces(m);
   std::vector<std::int32_t> piece_index(static_cast<std::size_t>(labels.count));
+  std::vector<int> piece_faces(static_cast<std::size_t>(labels.count), 0);
+  for (const auto p : labels.face_piece) ++piece_faces[static_cast<std::size_t>(p)];
   for (std::int32_t p = 0; p < labels.count; ++p) {
-    new_piece();
+    btSoftBody& body = *new_piece().body;
     piece_index[static_cast<std::size_t>(p)] = std::int32_t(pieces_.size()) - 1;
+    // Empty bodies: reserving moves nothing that is pointed to. Twice the size leaves room for
+    // edits (a full array would be copied, and every node pointer re-pointed, when it grows).
+    const int faces = piece_faces[static_cast<std::size_t>(p)];
+    body.m_nodes.reserve(2 * (faces / 2 + 3));
+    body.m_faces.reserve(2 * faces);
+    const int links = 2 * (3 * faces / 2 + 3) * (material_.bending_stiffness > 0 ? 2 : 1);
+    body.m_links.reserve(links);
+    Piece& piece = *pieces_.back();
+    piece.node_vertex.reserve(std::size_t(2 * (faces / 2 + 3)));
+    piece.face_id.reserve(std::size_t(2 * faces));
+    piece.rest.reserve(std::size_t(links));
+    piece.link_key.reserve(std::size_t(links));
+    piece.link_bend.reserve(std::size_t(links));
   }
   for (std::int32_t v = 0; v < m.vertex_count(); ++v) {
     const auto& vf = vertex_faces_[static_cast<std::size_t>(v)];
@@ -418,6 +443,7 @@ void SkinnedSoftBody::add_bending(std::int32_t p, std::int32_t a, std::int32_t b
                   body.m_materials[1], false);
   body.m_bUpdateRtCst = reset;
   btSoftBody::Link& link = body.m_links[body.m_links.size() - 1];
+  link.m_bbending = 1;
   link.m_rl = btScalar(rest);
   link.m_c1 = btScalar(rest * rest);
   link_constant(link);
@@ -673,14 +699,9 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   // groups are complete pieces (no larger than the growing one, up to the turn order); the
   // growing one is the rest of its body, which keeps its btSoftBody unexplored. Only if that
   // group reaches vertices of two bodies (a merge) or of none is it explored to the end.
-  // Each search expands first the vertex nearest to the far end of the changed region (of two
-  // poles of the seeds, the one farther from its own seed): separate clusters of changes (the
-  // two holes of a drill through both walls) meet along a short path instead of by two
-  // growing discs. The order changes only the cost, never which pieces are found.
   struct Search {
-    std::vector<std::int32_t> queue;                    // the vertices it labelled
-    std::vector<std::pair<double, std::int32_t>> heap;  // (squared distance to target, vertex)
-    Eigen::Vector3d target;
+    std::vector<std::int32_t> queue;  // the vertices it labelled, in order
+    std::size_t head = 0;             // queue[head..] are still to expand
     std::int32_t root;
   };
   std::vector<Search> searches;
@@ -692,34 +713,11 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     }
     return s;
   };
-  Eigen::Vector3d pole[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-  {
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (const auto v : seeds) centre += mesh_.current.col(v);
-    if (!seeds.empty()) centre /= double(seeds.size());
-    double far0 = -1, far1 = -1;
-    for (const auto v : seeds) {
-      const double d = (mesh_.current.col(v) - centre).squaredNorm();
-      if (d > far0) far0 = d, pole[0] = mesh_.current.col(v);
-    }
-    for (const auto v : seeds) {
-      const double d = (mesh_.current.col(v) - pole[0]).squaredNorm();
-      if (d > far1) far1 = d, pole[1] = mesh_.current.col(v);
-    }
-  }
-  auto heap_less = [](const std::pair<double, std::int32_t>& x,
-                      const std::pair<double, std::int32_t>& y) { return x.first > y.first; };
   for (const auto v : seeds) {
     const auto i = static_cast<std::size_t>(v);
     if (vertex_faces_[i].empty() || search_label_[i] >= 0) continue;
     search_label_[i] = std::int32_t(searches.size());
-    const Eigen::Vector3d x = mesh_.current.col(v);
-    Search search;
-    search.queue = {v};
-    search.target = (x - pole[0]).squaredNorm() > (x - pole[1]).squaredNorm() ? pole[0] : pole[1];
-    search.heap = {{(x - search.target).squaredNorm(), v}};
-    search.root = std::int32_t(searches.size());
-    searches.push_back(std::move(search));
+    searches.push_back({{v}, 0, std::int32_t(searches.size())});
   }
   std::vector<std::int32_t> active;
   for (std::size_t s = 0; s < searches.size(); ++s) active.push_back(std::int32_t(s));
@@ -753,9 +751,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     std::size_t kept = 0;
     for (const auto s : active) {
       auto& search = searches[static_cast<std::size_t>(s)];
-      std::pop_heap(search.heap.begin(), search.heap.end(), heap_less);
-      const std::int32_t u = search.heap.back().second;
-      search.heap.pop_back();
+      const std::int32_t u = search.queue[search.head++];
       std::int32_t rs = root_of(s);
       for (const auto f : vertex_faces_[static_cast<std::size_t>(u)])
         for (const auto w : faces_[static_cast<std::size_t>(f)]) {
@@ -764,8 +760,6 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
             label = s;
             auto& grow = searches[static_cast<std::size_t>(s)];
             grow.queue.push_back(w);
-            grow.heap.emplace_back((mesh_.current.col(w) - grow.target).squaredNorm(), w);
-            std::push_heap(grow.heap.begin(), grow.heap.end(), heap_less);
             continue;
           }
           const std::int32_t rw = root_of(label);
@@ -779,7 +773,8 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
           searches[static_cast<std::size_t>(o)].root = r;
           rs = r;
         }
-      if (!searches[static_cast<std::size_t>(s)].heap.empty())
+      if (searches[static_cast<std::size_t>(s)].head <
+          searches[static_cast<std::size_t>(s)].queue.size())
         active[kept++] = s;
       else if (--pending_in[static_cast<std::size_t>(rs)] == 0)
         --growing;
@@ -852,7 +847,8 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       if (p >= 0 && p != owner[c]) moving.push_back(v);
     }
     if (moving.empty()) continue;
-    if (owner[c] < 0) {
+    const bool fresh = owner[c] < 0;
+    if (fresh) {
       btSoftBody& body = *new_piece().body;
       owner[c] = std::int32_t(pieces_.size()) - 1;
       // An empty body: reserving moves nothing that is pointed to.
@@ -861,7 +857,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       body.m_faces.reserve(2 * n + 16);
       body.m_links.reserve(3 * n + 16);
     }
-    std::vector<std::pair<btVector3, btVector3>> state;
+    std::vector<btSoftBody::Node> state;
     for (const auto v : moving) {
       for (const auto f : vertex_faces_[static_cast<std::size_t>(v)]) {
         if (face_piece_[static_cast<std::size_t>(f)] < 0) continue;
@@ -880,8 +876,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
           --stats_.removed_links;
         }
       }
-      const btSoftBody::Node& node = body_of(v)->m_nodes[node_of_[static_cast<std::size_t>(v)]];
-      state.emplace_back(node.m_x, node.m_v);
+      state.push_back(body_of(v)->m_nodes[node_of_[static_cast<std::size_t>(v)]]);
     }
     {
       // Highest node first: the last nodes of a body are popped without a swap.
@@ -891,13 +886,44 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       });
       for (const auto v : order) remove_node(v);
     }
-    for (std::size_t i = 0; i < moving.size(); ++i) {
-      add_node(owner[c], moving[i], to_eigen(state[i].first), to_eigen(state[i].second));
-      // Bit-exact copy (the double round trip is exact, but say so in code).
-      btSoftBody::Node& node =
-          body_of(moving[i])->m_nodes[node_of_[static_cast<std::size_t>(moving[i])]];
-      node.m_x = node.m_q = state[i].first;
-      node.m_v = state[i].second;
+    Piece& into = *pieces_[static_cast<std::size_t>(owner[c])];
+    btSoftBody& body = *into.body;
+    if (fresh && body.m_nodes.capacity() >= int(moving.size())) {
+      // Into the new (reserved, so never reallocated) body: the nodes are copied whole (x, v
+      // and every other state bit-exact), then their tree leaves are inserted in bit-reversed
+      // order, which keeps Bullet's incrementally built node tree shallow (neighbours inserted
+      // one after the other make a deep one, and every later insert walks it).
+      for (std::size_t i = 0; i < moving.size(); ++i) {
+        body.m_nodes.push_back(state[i]);
+        btSoftBody::Node& node = body.m_nodes[body.m_nodes.size() - 1];
+        node.m_leaf = nullptr;
+        node.m_material = body.m_materials[0];
+        const auto v = static_cast<std::size_t>(moving[i]);
+        piece_of_[v] = owner[c];
+        node_of_[v] = body.m_nodes.size() - 1;
+        into.node_vertex.push_back(moving[i]);
+      }
+      const btScalar margin = body.getCollisionShape()->getMargin();
+      const auto n = static_cast<std::uint32_t>(moving.size());
+      int bits = 0;
+      while ((1u << bits) < n) ++bits;
+      for (std::uint32_t k = 0; k < (1u << bits); ++k) {
+        std::uint32_t r = 0;
+        for (int b = 0; b < bits; ++b) r |= ((k >> b) & 1u) << (bits - 1 - b);
+        if (r >= n) continue;
+        btSoftBody::Node& node = body.m_nodes[int(r)];
+        node.m_leaf = body.m_ndbvt.insert(btDbvtVolume::FromCR(node.m_x, margin), &node);
+      }
+    } else {
+      for (std::size_t i = 0; i < moving.size(); ++i) {
+        add_node(owner[c], moving[i], to_eigen(state[i].m_x), to_eigen(state[i].m_v));
+        // Bit-exact copy (the double round trip is exact, but say so in code).
+        btSoftBody::Node& node =
+            body_of(moving[i])->m_nodes[node_of_[static_cast<std::size_t>(moving[i])]];
+        node.m_x = state[i].m_x;
+        node.m_q = state[i].m_q;
+        node.m_v = state[i].m_v;
+      }
     }
     stats_.moved_nodes += std::int32_t(moving.size());
   }
