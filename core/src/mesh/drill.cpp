@@ -267,6 +267,15 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
   const double len = (tool.tip - tool.base).norm();
   Axis axis{tool.base, (tool.tip - tool.base) / len, len, tool.radius * tool.radius};
   DrillResult result;
+  // The index inserts only the faces that survive all the drill's changes.
+  struct Batch {
+    FaceIndex* index;
+    const SkinnedMesh& mesh;
+    ~Batch() {
+      if (index) index->end_batch(mesh);
+    }
+  } batch{index, mesh};
+  if (index) index->begin_batch();
   auto commit = [&](TopologyChange&& ch) {
     apply(mesh, ch, &adjacency);
     if (index) index->update(mesh, ch);

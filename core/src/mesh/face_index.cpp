@@ -374,6 +374,8 @@ void FaceIndex::split_leaf(const SkinnedMesh& mesh, std::int32_t n, std::int32_t
 
 void FaceIndex::erase(std::int32_t f) {
   const std::int32_t n = leaf_of_[static_cast<std::size_t>(f)];
+  leaf_of_[static_cast<std::size_t>(f)] = -1;
+  if (n < 0) return;  // deferred (or absent): nothing in the tree
   Node& leaf = nodes_[static_cast<std::size_t>(n)];
   for (std::int32_t i = 0; i < leaf.count; ++i)
     if (items_[static_cast<std::size_t>(leaf.first + i)] == f) {
@@ -387,6 +389,13 @@ void FaceIndex::erase(std::int32_t f) {
 
 void FaceIndex::rename(std::int32_t from, std::int32_t to) {
   const std::int32_t n = leaf_of_[static_cast<std::size_t>(from)];
+  if (n == kPending) {
+    pending_hint_.insert(0, to, hint_of(from), true);
+    pending_.push_back(to);
+    leaf_of_[static_cast<std::size_t>(to)] = kPending;
+    leaf_of_[static_cast<std::size_t>(from)] = -1;
+    return;
+  }
   const Node& leaf = nodes_[static_cast<std::size_t>(n)];
   for (std::int32_t i = 0; i < leaf.count; ++i)
     if (items_[static_cast<std::size_t>(leaf.first + i)] == from)
@@ -412,7 +421,7 @@ void FaceIndex::update(const SkinnedMesh& mesh, const TopologyChange& change) {
   const std::size_t nr = removed.size(), na = added.size();
   std::vector<std::int32_t> old_leaf(nr);
   for (std::size_t j = 0; j < nr; ++j) {
-    old_leaf[j] = leaf_of_[static_cast<std::size_t>(removed[j])];
+    old_leaf[j] = hint_of(removed[j]);
     erase(removed[j]);
   }
   std::vector<std::int32_t> slot_of(na);
@@ -444,8 +453,33 @@ void FaceIndex::update(const SkinnedMesh& mesh, const TopologyChange& change) {
   // leaf (and stays there when the leaf's box holds it).
   for (std::size_t k = 0; k < na; ++k) {
     const std::int32_t near = nr == 0 ? 0 : old_leaf[k * nr / na];
-    insert(mesh, slot_of[k], face_box(mesh, slot_of[k]), near);
+    add(mesh, slot_of[k], near);
   }
+}
+
+std::int32_t FaceIndex::hint_of(std::int32_t f) const {
+  const std::int32_t n = leaf_of_[static_cast<std::size_t>(f)];
+  if (n != kPending) return std::max(n, 0);
+  return std::max(pending_hint_.find(0, f), 0);
+}
+
+void FaceIndex::add(const SkinnedMesh& mesh, std::int32_t f, std::int32_t near) {
+  if (!batch_) return insert(mesh, f, face_box(mesh, f), near);
+  leaf_of_[static_cast<std::size_t>(f)] = kPending;
+  pending_hint_.insert(0, f, near, true);
+  pending_.push_back(f);
+}
+
+void FaceIndex::end_batch(const SkinnedMesh& mesh) {
+  batch_ = false;
+  for (auto f : pending_) {
+    if (f >= face_count() || leaf_of_[static_cast<std::size_t>(f)] != kPending) continue;
+    const std::int32_t near = hint_of(f);
+    leaf_of_[static_cast<std::size_t>(f)] = -1;
+    insert(mesh, f, face_box(mesh, f), near);
+  }
+  pending_.clear();
+  pending_hint_.clear();
 }
 
 int FaceIndex::depth() const {

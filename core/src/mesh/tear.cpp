@@ -132,6 +132,15 @@ TearStep Tear::advance(const ScalpelSample& s) {
     start(s, step);
     return step;
   }
+  // The index inserts only the faces that survive both phases of the step.
+  struct Batch {
+    FaceIndex* index;
+    const SkinnedMesh& mesh;
+    ~Batch() {
+      if (index) index->end_batch(mesh);
+    }
+  } batch{index_, mesh_};
+  if (index_) index_->begin_batch();
   const Eigen::Vector3d tip = mesh_.current.col(tip_);
   const auto plane = cga::Plane<double>::through(tip, s.a, s.b);
   if (!plane) {

@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "conform/mesh/adjacency.hpp"
 #include "conform/mesh/skinned_mesh.hpp"
 #include "conform/mesh/topology_change.hpp"
 
@@ -81,6 +82,11 @@ class FaceIndex {
   /// faces moved by the swap-with-last step are renamed. Throws std::invalid_argument when the
   /// change was not computed for the mesh this index describes.
   void update(const SkinnedMesh& mesh, const TopologyChange& change);
+  /// Between begin_batch() and end_batch(mesh), update() defers its insertions: an operation
+  /// that applies several changes in a row (the drill's refinements, then its hole) inserts
+  /// only the faces that survive them all. No queries (and no validate) inside a batch.
+  void begin_batch() { batch_ = true; }
+  void end_batch(const SkinnedMesh& mesh);
 
   /// True when the index describes a mesh of this face count (a cheap sanity check).
   bool matches(const SkinnedMesh& mesh) const { return face_count() == mesh.face_count(); }
@@ -127,11 +133,18 @@ class FaceIndex {
   void rename(std::int32_t from, std::int32_t to);
   void split_leaf(const SkinnedMesh& mesh, std::int32_t n, std::int32_t extra);
   void grow_up(std::int32_t n, const Box& box);
+  void add(const SkinnedMesh& mesh, std::int32_t f, std::int32_t near);  // insert, or defer
+  std::int32_t hint_of(std::int32_t f) const;
+
+  static constexpr std::int32_t kPending = -2;  // leaf_of_ of a deferred face
 
   std::vector<Node> nodes_;            // children always after their parent
   std::vector<std::int32_t> items_;    // leaf blocks of face slots
-  std::vector<std::int32_t> leaf_of_;  // face slot → its leaf
+  std::vector<std::int32_t> leaf_of_;  // face slot → its leaf (kPending: deferred)
   bool fitted_ = false;
+  bool batch_ = false;
+  std::vector<std::int32_t> pending_;  // deferred slots (may repeat, or be gone)
+  EdgeMap pending_hint_;               // (0, slot) → where to start inserting it
 };
 
 }  // namespace conform::mesh
