@@ -232,6 +232,7 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
     if (vf.empty()) {  // no faces: not a node (its mass stays in the books)
       detached_slot_[static_cast<std::size_t>(v)] = std::int32_t(detached_state_.size());
       detached_state_.emplace_back(m.current.col(v), Eigen::Vector3d::Zero());
+      detached_vertex_.push_back(v);
       ++detached_count_;
       continue;
     }
@@ -366,6 +367,7 @@ void SkinnedSoftBody::detach(std::int32_t v) {
   remove_node(v);
   detached_slot_[i] = std::int32_t(detached_state_.size());
   detached_state_.emplace_back(x, vel);
+  detached_vertex_.push_back(v);
   ++detached_count_;
   ++stats_.detached_nodes;
 }
@@ -942,6 +944,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       detached_slot_[static_cast<std::size_t>(id)] = std::int32_t(detached_state_.size());
       detached_state_.emplace_back(nx[static_cast<std::size_t>(i)],
                                    nv[static_cast<std::size_t>(i)]);
+      detached_vertex_.push_back(id);
       ++detached_count_;
       ++stats_.detached_nodes;
       continue;
@@ -1170,6 +1173,12 @@ void SkinnedSoftBody::update(double dt, double time) {
         previous_target_.x[v] = target_.x[v], previous_target_.y[v] = target_.y[v],
         previous_target_.z[v] = target_.z[v];
     fill_previous_ = false;
+  }
+  for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot) {
+    const auto v = static_cast<std::size_t>(detached_vertex_[slot]);
+    const Eigen::Vector3d t(target_.x[v], target_.y[v], target_.z[v]),
+        tp(previous_target_.x[v], previous_target_.y[v], previous_target_.z[v]);
+    detached_state_[slot] = {t, (t - tp) / dt};
   }
   const double k = material_.target_stiffness, c = material_.target_damping;
   const double dt2 = dt * dt, denom = 1 + c * dt + k * dt2;

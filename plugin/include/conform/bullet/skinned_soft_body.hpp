@@ -6,8 +6,9 @@
 // edge shared by two faces. Every connected piece of the mesh is its own btSoftBody (Bullet's
 // face tree never returns on a body whose faces are not edge-connected). A vertex left without
 // faces (the inside of a drilled hole) is detached: it leaves Bullet (no node, link, collision
-// or solver work), and its mass and momentum at that moment stay in the books (total_mass(),
-// momentum()) as the removed material's, so that edits conserve both exactly.
+// or solver work); its mass stays in the books (total_mass(), momentum()) as the removed
+// material's, with its state at the edit (so that edits conserve both exactly), and from the
+// next substep on it rides its skinned target.
 //
 // Edits cost time proportional to the change: nodes, links and faces are removed by
 // swap-with-last with local re-pointing; link constants, rest lengths and face areas of what
@@ -188,8 +189,12 @@ class SkinnedSoftBody {
   /// Bending links over all pieces, and our rest length of the one across edge (u, v) (−1).
   std::int32_t bending_link_count() const;
   double bending_rest_length(std::int32_t u, std::int32_t v) const;
-  /// The vertex left Bullet (it has no faces): position() and velocity() are its state when
-  /// it left; body_of() is null and node_of() −1.
+  /// The vertex left Bullet (it has no faces; e.g. the inside of a drilled hole): no node,
+  /// link, face or collision of its own. Its mass stays in the books. position() and
+  /// velocity() are its state when it left (so an edit conserves Σm and Σm·v exactly) until
+  /// the next substep, and from then on its skinned target's (it rides the skeleton like
+  /// removed material held by the tool, and never drifts from its target); body_of() is null
+  /// and node_of() −1.
   bool detached(std::int32_t vertex) const {
     return piece_of_[static_cast<std::size_t>(vertex)] < 0;
   }
@@ -258,7 +263,8 @@ class SkinnedSoftBody {
   mesh::EdgeMap bend_link_;
   // Detached vertices: their position and velocity when they left Bullet.
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> detached_state_;
-  std::vector<std::int32_t> detached_slot_;  // per vertex, −1 unless detached
+  std::vector<std::int32_t> detached_slot_;    // per vertex, −1 unless detached
+  std::vector<std::int32_t> detached_vertex_;  // per slot
   std::int32_t detached_count_ = 0;
   // Split search scratch (per vertex, −1 between searches).
   std::vector<std::int32_t> search_label_;
