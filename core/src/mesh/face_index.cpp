@@ -254,7 +254,16 @@ void FaceIndex::build(const SkinnedMesh& mesh) {
     stack.push_back({child + 1, mid, task.end});
     stack.push_back({child, task.begin, mid});
   }
+  reserve(nf / 8 + 1024);
   refit(mesh);
+}
+
+void FaceIndex::reserve(std::int32_t more) {
+  // Each leaf split (about one per four inserted faces) adds two nodes and one leaf block.
+  const auto m = static_cast<std::size_t>(std::max(more, 0));
+  nodes_.reserve(nodes_.size() + m / 2 + 16);
+  items_.reserve(items_.size() + kLeafCapacity * (m / 4 + 16));
+  leaf_of_.reserve(leaf_of_.size() + m);
 }
 
 void FaceIndex::refit(const SkinnedMesh& mesh) {

@@ -27,7 +27,8 @@
 // change it applies. Without one, it builds a temporary index (O(F log F)): keep an index for
 // haptic rates (see face_index.hpp for who refits when).
 //
-// Degenerate input — non-finite points or radius, r ≤ 0, A = B — throws
+// Degenerate input — non-finite points or radius, r ≤ 0, A = B, non-finite positions of the
+// faces the drill reaches — throws
 // std::invalid_argument; a drill that pierces nothing returns holes = 0 and changes nothing.
 #pragma once
 

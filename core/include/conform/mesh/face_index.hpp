@@ -88,6 +88,10 @@ class FaceIndex {
   void begin_batch() { batch_ = true; }
   void end_batch(const SkinnedMesh& mesh);
 
+  /// Room for `more` faces beyond the current count without reallocating (a copy of an index
+  /// has none; build() leaves some).
+  void reserve(std::int32_t more);
+
   /// True when the index describes a mesh of this face count (a cheap sanity check).
   bool matches(const SkinnedMesh& mesh) const { return face_count() == mesh.face_count(); }
   std::int32_t face_count() const { return static_cast<std::int32_t>(leaf_of_.size()); }
