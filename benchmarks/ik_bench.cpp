@@ -8,9 +8,9 @@
 //   scalar_q12   the previous formulation (Qs = Q12·Q3, kernel_q12.hpp) with its per-call arm
 //                constants, as the library's solve() was before: the in-run baseline
 //   scalar       solve(arm, target, φ): arm constants computed on every call
-//   solver       ArmSolver::solve(target, φ): constants once (the headline scalar figure)
-//   solver_cs    ArmSolver::solve(target, {cos φ, sin φ}) with the pair precomputed per target
-//   latency      ArmSolver::solve(target, φ) with each target depending on the previous result
+//   arm_ik       ArmIk::solve(target, φ): constants once (the headline scalar figure)
+//   arm_ik_cs    ArmIk::solve(target, {cos φ, sin φ}) with the pair precomputed per target
+//   latency      ArmIk::solve(target, φ) with each target depending on the previous result
 //                (no overlap between consecutive solves: the time of one solve, start to end)
 //   latency_q12  the same for the previous formulation
 //
@@ -163,9 +163,9 @@ const char* scalar_name(Scalar v) {
     case Scalar::kFree:
       return "scalar";
     case Scalar::kSolver:
-      return "solver";
+      return "arm_ik";
     case Scalar::kSolverCosSin:
-      return "solver_cs";
+      return "arm_ik_cs";
     case Scalar::kLatency:
       return "latency";
     case Scalar::kLatencyQ12:
@@ -178,7 +178,7 @@ template <class T, Scalar kVariant>
 void BM_Scalar(benchmark::State& state) {
   auto& d = data<T>(4096);
   const ik::Arm<T> arm;
-  const ik::ArmSolver<T> solver(arm);
+  const ik::ArmIk<T> solver(arm);
   // An opaque zero: the latency variant adds zero·(previous result) to the next target, so
   // that each solve waits for the one before.
   T zero = 0;
@@ -257,12 +257,12 @@ BENCHMARK(BM_Scalar<float, Scalar::kQ12>)->Name("BM_ScalarQ12/float");
 BENCHMARK(BM_Scalar<double, Scalar::kQ12>)->Name("BM_ScalarQ12/double");
 BENCHMARK(BM_Scalar<float, Scalar::kFree>)->Name("BM_ScalarFast/float");
 BENCHMARK(BM_Scalar<double, Scalar::kFree>)->Name("BM_ScalarFast/double");
-BENCHMARK(BM_Scalar<float, Scalar::kSolver>)->Name("BM_ArmSolver/float");
-BENCHMARK(BM_Scalar<double, Scalar::kSolver>)->Name("BM_ArmSolver/double");
-BENCHMARK(BM_Scalar<float, Scalar::kSolverCosSin>)->Name("BM_ArmSolverCosSin/float");
-BENCHMARK(BM_Scalar<double, Scalar::kSolverCosSin>)->Name("BM_ArmSolverCosSin/double");
-BENCHMARK(BM_Scalar<float, Scalar::kLatency>)->Name("BM_ArmSolverLatency/float");
-BENCHMARK(BM_Scalar<double, Scalar::kLatency>)->Name("BM_ArmSolverLatency/double");
+BENCHMARK(BM_Scalar<float, Scalar::kSolver>)->Name("BM_ArmIk/float");
+BENCHMARK(BM_Scalar<double, Scalar::kSolver>)->Name("BM_ArmIk/double");
+BENCHMARK(BM_Scalar<float, Scalar::kSolverCosSin>)->Name("BM_ArmIkCosSin/float");
+BENCHMARK(BM_Scalar<double, Scalar::kSolverCosSin>)->Name("BM_ArmIkCosSin/double");
+BENCHMARK(BM_Scalar<float, Scalar::kLatency>)->Name("BM_ArmIkLatency/float");
+BENCHMARK(BM_Scalar<double, Scalar::kLatency>)->Name("BM_ArmIkLatency/double");
 BENCHMARK(BM_Scalar<float, Scalar::kLatencyQ12>)->Name("BM_ScalarQ12Latency/float");
 BENCHMARK(BM_Scalar<double, Scalar::kLatencyQ12>)->Name("BM_ScalarQ12Latency/double");
 BENCHMARK(BM_Batch<float>)
@@ -312,9 +312,9 @@ int main(int argc, char** argv) {
   // CPU-time ratios of the scalar solves to the previous formulation (printed by the reporter).
   for (const char* p : {"float", "double"}) {
     const std::string base = std::string("BM_ScalarQ12/") + p;
-    for (const char* v : {"BM_ScalarFast/", "BM_ArmSolver/", "BM_ArmSolverCosSin/"})
+    for (const char* v : {"BM_ScalarFast/", "BM_ArmIk/", "BM_ArmIkCosSin/"})
       conform::bench::add_ratio(v + std::string(p), base);
-    conform::bench::add_ratio(std::string("BM_ArmSolverLatency/") + p,
+    conform::bench::add_ratio(std::string("BM_ArmIkLatency/") + p,
                               std::string("BM_ScalarQ12Latency/") + p);
   }
   const int rc = conform::bench::run_with_ratios(argc, argv);

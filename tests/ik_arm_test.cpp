@@ -1,6 +1,6 @@
 // Arm IK (conform/ik/arm_ik.hpp): forward kinematics is the judge. The closed form (scalar and
 // batch, float and double), the readable algebra version, the explicit elbow branch, tracking
-// smoothness, the edge cases and the joint limits; ArmSolver and the (cos φ, sin φ) swivel;
+// smoothness, the edge cases and the joint limits; ArmIk and the (cos φ, sin φ) swivel;
 // the previous Q12·Q3 kernel as a cross-check. Fixed seeds throughout.
 #include <gtest/gtest.h>
 
@@ -206,7 +206,7 @@ Targets<double> mixed_targets(std::size_t n, double d1, double d2, unsigned seed
 
 }  // namespace
 
-// ArmSolver is solve(arm, …) with the constants kept: the same numbers, bit for bit, for every
+// ArmIk is solve(arm, …) with the constants kept: the same numbers, bit for bit, for every
 // kind of arm and target. The (cos φ, sin φ) overload agrees with the angle (its pair comes
 // from std::cos/std::sin, the angle's from the kernel's polynomial: rounding apart) and accepts
 // any positive multiple of the pair.
@@ -217,7 +217,7 @@ TEST(IkSolver, MatchesFreeSolveAndCosSinOverload) {
   arms[3].limits.cone_axis = Vec3d(0, 0, 1), arms[3].limits.cone_half_angle = 1.2;
   for (std::size_t a = 0; a < arms.size(); ++a) {
     const ik::Arm<double>& arm = arms[a];
-    const ik::ArmSolver<double> solver(arm);
+    const ik::ArmIk<double> solver(arm);
     ASSERT_TRUE(solver.valid());
     const double scale = arm.upper + arm.fore;
     const auto t = mixed_targets(3000, arm.upper, arm.fore, 600 + unsigned(a));
@@ -255,7 +255,7 @@ TEST(IkSolver, MatchesFreeSolveAndCosSinOverload) {
   variants[4].limits.cone_half_angle = 0.9;
   variants.push_back(variants[4]);
   variants[5].limits.cone_axis = Vec3d(0, 1, 1);
-  std::vector<ik::ArmSolver<double>> solvers(variants.begin(), variants.end());
+  std::vector<ik::ArmIk<double>> solvers(variants.begin(), variants.end());
   const auto t = random_targets<double>(300, 0.3, 0.25, 91);
   for (std::size_t i = 0; i < t.x.size(); ++i) {
     const std::size_t k = (i * 7) % variants.size();
@@ -268,7 +268,7 @@ TEST(IkSolver, MatchesFreeSolveAndCosSinOverload) {
   }
 
   // Invalid pairs and arms.
-  const ik::ArmSolver<double> solver;
+  const ik::ArmIk<double> solver;
   for (const auto& cs : {ik::SwivelCosSin<double>{0, 0}, ik::SwivelCosSin<double>{std::nan(""), 1},
                          ik::SwivelCosSin<double>{INFINITY, 0}}) {
     const auto s = solver.solve(Vec3d(0.1, 0.2, 0.3), cs);
@@ -278,7 +278,7 @@ TEST(IkSolver, MatchesFreeSolveAndCosSinOverload) {
   }
   EXPECT_EQ(solver.solve(Vec3d(0.1, std::nan(""), 0.3), 0.2).status, ik::Status::kInvalidInput);
   EXPECT_EQ(solver.solve(Vec3d(0.1, 0.2, 0.3), 2e4).status, ik::Status::kInvalidInput);
-  const ik::ArmSolver<double> bad(ik::Arm<double>{0.3, -0.1, {}});
+  const ik::ArmIk<double> bad(ik::Arm<double>{0.3, -0.1, {}});
   EXPECT_FALSE(bad.valid());
   EXPECT_EQ(bad.solve(Vec3d(0.1, 0.2, 0.3), 0.2).status, ik::Status::kInvalidInput);
   EXPECT_EQ(bad.solve(Vec3d(0.1, 0.2, 0.3), ik::SwivelCosSin<double>{}).status,

@@ -292,26 +292,26 @@ template Solution<float> solve(const Arm<float>&, const Vec3<float>&, SwivelCosS
 template Solution<double> solve(const Arm<double>&, const Vec3<double>&, SwivelCosSin<double>);
 
 template <class T>
-ArmSolver<T>::ArmSolver(const Arm<T>& arm) : arm_(arm), valid_(arm.valid()) {
+ArmIk<T>::ArmIk(const Arm<T>& arm) : arm_(arm), valid_(arm.valid()) {
   if (valid_) constants_ = constants(arm);
 }
 
 template <class T>
-Solution<T> ArmSolver<T>::solve(const Vec3<T>& target, T swivel) const {
+Solution<T> ArmIk<T>::solve(const Vec3<T>& target, T swivel) const {
   if (!valid_) [[unlikely]]
     return invalid_arm<T>();
   return solve_angle(arm_, constants_, target, swivel);
 }
 
 template <class T>
-Solution<T> ArmSolver<T>::solve(const Vec3<T>& target, SwivelCosSin<T> swivel) const {
+Solution<T> ArmIk<T>::solve(const Vec3<T>& target, SwivelCosSin<T> swivel) const {
   if (!valid_) [[unlikely]]
     return invalid_arm<T>();
   return solve_dir(arm_, constants_, target, swivel);
 }
 
-template class ArmSolver<float>;
-template class ArmSolver<double>;
+template class ArmIk<float>;
+template class ArmIk<double>;
 
 // ----- batch -----
 

@@ -19,9 +19,9 @@
 // - Qs is returned with qs.w ≥ 0 (q and −q are the same rotation).
 //
 // Three solvers give the same answer: solve_readable (the algebra, arm_ik_readable.cpp),
-// solve / ArmSolver (the closed form, scalar) and BatchSolveJob (the closed form over
+// solve / ArmIk (the closed form, scalar) and BatchSolveJob (the closed form over
 // structure-of-arrays data, SIMD and OpenMP threads). See arm_ik_readable.cpp for every sign
-// changed vs the paper. ArmSolver computes the arm's constants once; solve(arm, …) keeps them
+// changed vs the paper. ArmIk computes the arm's constants once; solve(arm, …) keeps them
 // per thread for the last arm it saw.
 #pragma once
 
@@ -134,7 +134,7 @@ struct SwivelCosSin {
 
 /// Fast closed form (eqs 10–18 re-derived for accuracy), one target. Honours all limits.
 /// The arm's constants are kept per thread for the last arm seen (recomputed when any field
-/// of the arm differs); ArmSolver keeps them explicitly.
+/// of the arm differs); ArmIk keeps them explicitly.
 template <class T>
 Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, T swivel);
 template <class T>
@@ -143,9 +143,9 @@ Solution<T> solve(const Arm<T>& arm, const Vec3<T>& target, SwivelCosSin<T> swiv
 /// The fast closed form for one arm: the arm's constants (lengths, squares, reciprocals and
 /// the elbow range's reach) are computed once, here. Same results as solve(arm, …).
 template <class T = double>
-class ArmSolver {
+class ArmIk {
  public:
-  explicit ArmSolver(const Arm<T>& arm = Arm<T>{});
+  explicit ArmIk(const Arm<T>& arm = Arm<T>{});
   const Arm<T>& arm() const { return arm_; }
   /// False for an invalid arm (then every solve returns kInvalidInput).
   bool valid() const { return valid_; }
@@ -158,8 +158,8 @@ class ArmSolver {
   bool valid_ = false;
 };
 
-extern template class ArmSolver<float>;
-extern template class ArmSolver<double>;
+extern template class ArmIk<float>;
+extern template class ArmIk<double>;
 
 /// The geometric version written with the algebra: spheres, circle Ze = S1∧S2, swivel plane,
 /// point pair Pp = Ze∧π, lines L_se, L_ew, angles by eq 5, quaternions by eqs 8, 9, 14–18.

@@ -144,7 +144,7 @@ template <class T>
   return {r.s * a + r.c * b, r.c * a - r.s * b};
 }
 
-/// Per-arm constants, computed once per ArmSolver or batch (or per call of the free solve()).
+/// Per-arm constants, computed once per ArmIk or batch (the free solve() keeps the last ones).
 template <class T>
 struct KernelConstants {
   T d1;
