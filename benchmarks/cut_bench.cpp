@@ -260,7 +260,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
     ConsoleReporter::ReportRuns(runs);
     for (const auto& run : runs) {
       std::string name = run.run_name.str();
-      if (const auto at = name.find("/manual_time"); at != std::string::npos) name.erase(at);
+      for (const char* tag : {"/iterations:", "/manual_time"})  // not part of the pair names
+        if (const auto at = name.find(tag); at != std::string::npos)
+          name.erase(at, name.find('/', at + 1) - at);
       const double t = run.GetAdjustedRealTime();
       if (run.run_type == Run::RT_Aggregate) {
         if (run.aggregate_name == "median") median_[name] = t;
