@@ -3,11 +3,11 @@
 // `speedup` counters (paper time / our time): tear 2437 ms, drill 274 ms. (Moved here from
 // mesh_bench.cpp.)
 //
-// Every operation runs in three modes, in the same process:
+// Every operation runs in two modes, in the same process (the signatures without an index
+// scan too: for one query a scan is cheaper than building an index):
 //   index — through a FaceIndex kept in sync (built once per mesh state, outside the timing);
 //   scan  — FaceSearch::Scan, one scan of every face (the former behaviour);
-//   temp  — the signatures without an index, which build a temporary one per call.
-// and the run ends with the ratios index / scan and temp / scan of the median times.
+// and the run ends with the ratios index / scan of the median times.
 // BM_Index* time the index's own upkeep (build, refit) and one segment query against a scan.
 //
 // Every benchmark times only the operation (manual time, in thread CPU time): restoring the
@@ -39,7 +39,7 @@ namespace {
 constexpr double kPaperTearSeconds = 2.437;
 constexpr double kPaperDrillSeconds = 0.274;
 constexpr int kSizes[] = {0, 50000, 500000, 2000000};
-const char* const kModes[] = {"index", "scan", "temp"};
+const char* const kModes[] = {"index", "scan"};
 
 // Arm sizes: 0 → the default arm (5,120 faces); else about that many faces.
 struct Model {
@@ -222,7 +222,7 @@ class RatioReporter : public benchmark::ConsoleReporter {
     for (const auto& [name, t] : median_) {
       const auto at = name.find("/scan");
       if (at == std::string::npos) continue;
-      for (const char* mode : {"index", "temp"}) {
+      for (const char* mode : {"index"}) {
         std::string other = name;
         other.replace(at + 1, 4, mode);
         auto it = median_.find(other);
@@ -241,7 +241,7 @@ void register_all() {
   for (int faces : kSizes) {
     const int it = faces >= 500000 ? 5 : 30;
     const std::string size = "/faces:" + std::to_string(faces);
-    for (int mode = 0; mode < 3; ++mode) {
+    for (int mode = 0; mode < 2; ++mode) {
       const std::string tail = size + "/" + kModes[mode];
       benchmark::RegisterBenchmark(("BM_TearStep" + tail).c_str(),
                                    [=](benchmark::State& s) { tear_step(s, faces, mode); })

@@ -240,8 +240,9 @@ TEST(Drill, TubeOnlyJoinsEntryAndExit) {
   EXPECT_FALSE(check_mesh(m2).closed());
 }
 
-TEST(Drill, IndexScanAndTemporaryIndexAgree) {
-  // The same drill through the kept index, a temporary one and the scan: identical changes.
+TEST(Drill, IndexScanAndNoIndexAgree) {
+  // The same drill through the kept index, without an index and by FaceSearch::Scan: identical
+  // changes.
   const SkinnedMesh arm = make_arm(1).mesh;
   const DrillTool tool{{0.01, -0.2, 0.4}, {-0.01, 0.2, 0.43}, 0.009};
   std::vector<SkinnedMesh> out;

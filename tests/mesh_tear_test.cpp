@@ -223,8 +223,8 @@ TEST(Tear, ReDeformation) {
   RecordProperty("worst_new_vertex_error", std::to_string(worst));
 }
 
-TEST(Tear, IndexScanAndTemporaryIndexStartAlike) {
-  // The tear through a kept FaceIndex, a temporary one and the brute-force scan makes the same
+TEST(Tear, IndexScanAndNoIndexStartAlike) {
+  // The tear through a kept FaceIndex, without an index and by FaceSearch::Scan makes the same
   // changes; the kept index stays in sync (sound, and it answers as the scan does).
   const SkinnedMesh in = make_arm(1).mesh;
   std::vector<SkinnedMesh> out;

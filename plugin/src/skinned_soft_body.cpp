@@ -119,6 +119,7 @@ SkinnedSoftBody::SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(b
   if (!(material_.bending_stiffness >= 0 && material_.bending_stiffness <= 1))
     throw std::invalid_argument("SkinnedSoftBody: bending_stiffness must be in [0, 1]");
   adjacency_.build(mesh_);
+  face_index_.build(mesh_);
   pose_ = skin::Pose::rest(skeleton_);
   global_.resize(static_cast<std::size_t>(skeleton_.joint_count()));
   versors_.resize(static_cast<std::size_t>(skeleton_.bone_count()));
@@ -1038,12 +1039,14 @@ void SkinnedSoftBody::apply(const mesh::TopologyChange& change) {
   stats_ = {};
   auto clock = Clock::now();
   mesh::apply(mesh_, change, &adjacency_);
+  face_index_.update(mesh_, change);
   stats_.seconds.mesh += seconds_since(clock);
   mirror(change);
 }
 
 void SkinnedSoftBody::sync_mesh() {
   for (std::int32_t v = 0; v < mesh_.vertex_count(); ++v) mesh_.current.col(v) = position(v);
+  face_index_.mark_moved();
 }
 
 mesh::CutResult SkinnedSoftBody::cut(const cga::Plane<double>& plane,
@@ -1066,14 +1069,14 @@ mesh::DrillResult SkinnedSoftBody::drill(const mesh::DrillTool& tool,
   auto clock = Clock::now();
   sync_mesh();
   stats_.seconds.sync = seconds_since(clock);
-  mesh::DrillResult result = mesh::drill(mesh_, adjacency_, tool, options);
+  mesh::DrillResult result = mesh::drill(mesh_, adjacency_, face_index_, tool, options);
   stats_.seconds.mesh = seconds_since(clock);
   for (const auto& change : result.changes) mirror(change);
   return result;
 }
 
 void SkinnedSoftBody::begin_tear(const mesh::TearOptions& options) {
-  tear_ = std::make_unique<mesh::Tear>(mesh_, adjacency_, options);
+  tear_ = std::make_unique<mesh::Tear>(mesh_, adjacency_, face_index_, options);
 }
 
 mesh::TearStep SkinnedSoftBody::tear_advance(const mesh::ScalpelSample& sample) {

@@ -82,7 +82,8 @@ std::vector<SegmentHit> pierced_faces(const SkinnedMesh& mesh, FaceIndex* index,
     index->ensure_fitted(mesh);
     return index->segment_hits(mesh, tool.base, tool.tip);
   }
-  return FaceIndex(mesh).segment_hits(mesh, tool.base, tool.tip);
+  // No index kept by the caller: for one query a scan (O(F)) is cheaper than a build.
+  return scan_segment_hits(mesh, tool.base, tool.tip);
 }
 
 }  // namespace

@@ -94,8 +94,9 @@ bool Tear::start(const ScalpelSample& s, TearStep& step) {
       throw std::invalid_argument("tear: the face index does not describe this mesh");
     index_->ensure_fitted(mesh_);
     first = index_->first_hit(mesh_, s.a, s.b);
-  } else {
-    first = FaceIndex(mesh_).first_hit(mesh_, s.a, s.b);
+  } else {  // no index kept by the caller: for one query a scan is cheaper than a build
+    const auto hits = scan_segment_hits(mesh_, s.a, s.b);
+    if (!hits.empty()) first = hits.front();
   }
   const std::int32_t hit = first.face;
   std::array<double, 3> bary = first.bary;

@@ -24,8 +24,8 @@
 //      the surface, so that a closed input stays closed. A pair whose rims are not two simple
 //      loops winding once around the axis is left open (see message).
 // Given a FaceIndex, the drill refits it first if it was marked moved and updates it for every
-// change it applies. Without one, it builds a temporary index (O(F log F)): keep an index for
-// haptic rates (see face_index.hpp for who refits when).
+// change it applies. Without one, it scans every face once (O(F), cheaper than building an
+// index for one query): keep an index for haptic rates (see face_index.hpp for who refits when).
 //
 // Degenerate input — non-finite points or radius, r ≤ 0, A = B, non-finite positions of the
 // faces the drill reaches — throws
@@ -70,7 +70,7 @@ struct DrillResult {
   std::string message;
 };
 
-/// Drills `mesh` (and keeps `adjacency` up to date), with a temporary face index.
+/// Drills `mesh` (and keeps `adjacency` up to date), finding the pierced faces by one scan.
 DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool,
                   const DrillOptions& options = {});
 /// Drills `mesh`, keeping `adjacency` and `index` (which must describe the mesh) up to date.

@@ -15,9 +15,9 @@
 // Only the start queries the index; every later step is local. Given a FaceIndex, the tear
 // refits it before its query if it was marked moved (FaceIndex::ensure_fitted), updates it for
 // every change it applies, and marks it moved when open() moves positions, so it stays in sync.
-// Without one, each start attempt builds a temporary index (O(F log F)): keep an index for
-// haptic rates. TearOptions::search = FaceSearch::Scan scans every face instead (the former
-// behaviour, kept as the oracle of tests and benchmarks).
+// Without one, each start attempt scans every face once (O(F), cheaper than building an index
+// for one query): keep an index for haptic rates. TearOptions::search = FaceSearch::Scan scans
+// even when an index is given (the oracle of tests and benchmarks).
 // Every step is one or two TopologyChanges (insert, then separate), applied at once and
 // returned so a soft body can mirror them. New vertices carry weights, UVs and normals as
 // described in topology_change.hpp.

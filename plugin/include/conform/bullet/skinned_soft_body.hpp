@@ -39,6 +39,7 @@
 #include "conform/mesh/adjacency.hpp"
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/drill.hpp"
+#include "conform/mesh/face_index.hpp"
 #include "conform/mesh/skinned_mesh.hpp"
 #include "conform/mesh/tear.hpp"
 #include "conform/mesh/topology_change.hpp"
@@ -233,6 +234,9 @@ class SkinnedSoftBody {
   std::function<void(btSoftBody*)> add_, remove_;
   mesh::SkinnedMesh mesh_;
   mesh::Adjacency adjacency_;
+  // Tear starts and drills query it; synced positions only mark it moved, so its refit is paid
+  // when a tear starts or a drill runs, not every step (face_index.hpp).
+  mesh::FaceIndex face_index_;
   skin::Skeleton skeleton_;
   Material material_;
   std::unique_ptr<mesh::Tear> tear_;
