@@ -31,8 +31,11 @@
 #include "conform/mesh/face_index.hpp"
 #include "conform/mesh/procedural_arm.hpp"
 #include "conform/mesh/tear.hpp"
+#include "mesh_bench_util.hpp"
 
 using namespace conform::mesh;
+using conform::bench::speedup;
+using conform::bench::timed;
 
 namespace {
 
@@ -51,42 +54,10 @@ const Model& model(int faces) {
   static std::map<int, Model> cache;
   auto it = cache.find(faces);
   if (it != cache.end()) return it->second;
-  ArmOptions o;
-  if (faces > 0) {
-    // #F = 2 · rings · segments with rings ≈ 2.5 segments, as in the default arm.
-    o.segments = static_cast<int>(std::lround(std::sqrt(faces / 5.0)));
-    o.rings = static_cast<int>(std::lround(faces / (2.0 * o.segments)));
-  }
-  Model m{make_arm(o).mesh, {}, {}};
+  Model m{make_arm(conform::bench::arm_with_faces(faces)).mesh, {}, {}};
   m.adjacency.build(m.mesh);
   m.index.build(m.mesh);
   return cache.emplace(faces, std::move(m)).first->second;
-}
-
-// Times `op` alone (the set-up before it is not timed: these benchmarks use manual time) in
-// this thread's CPU time, which a machine shared with other jobs does not inflate; the
-// operations are single-threaded. Returns its seconds.
-double thread_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-template <class Fn>
-double timed(benchmark::State& state, Fn op) {
-  const double t0 = thread_seconds();
-  op();
-  const double s = thread_seconds() - t0;
-  state.SetIterationTime(s);
-  return s;
-}
-
-// The paper's time and ours per operation, and their ratio (paper / ours).
-void speedup(benchmark::State& state, double paper_seconds, double total_seconds) {
-  const auto n = std::max<benchmark::IterationCount>(state.iterations(), 1);
-  const double ours = total_seconds / static_cast<double>(n);
-  state.counters["ours_ms"] = ours * 1e3;
-  state.counters["paper_ms"] = paper_seconds * 1e3;
-  state.counters["speedup"] = paper_seconds / ours;
 }
 
 ScalpelSample arm_blade(int i, int n) {
