@@ -1,7 +1,7 @@
 // Tear and drill on the procedural arm at the paper's size (5,120 faces; the paper's arm has
 // 5,037) and at 50k, 500k and 2M faces, with the paper's Python timings beside ours as
-// `speedup` counters (paper time / our time): tear 2437 ms, drill 274 ms. (Moved here from
-// mesh_bench.cpp.)
+// `speedup` counters (paper time / our time): tear 2437 ms, drill 274 ms. (The cut is in
+// cut_bench.cpp.)
 //
 // Every operation runs in two modes, in the same process (the signatures without an index
 // scan too: for one query a scan is cheaper than building an index):
