@@ -225,24 +225,8 @@ void table1_sub4(benchmark::State& state) {
 }
 
 // Ratios of median manual times, measured in the same run.
-class RatioReporter : public benchmark::ConsoleReporter {
+class RatioReporter : public conform::bench::ManualTimeMedians {
  public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const auto& run : runs) {
-      std::string name = run.run_name.str();
-      for (const char* tag : {"/iterations:", "/manual_time"})  // not part of the pair names
-        if (const auto at = name.find(tag); at != std::string::npos)
-          name.erase(at, name.find('/', at + 1) - at);
-      const double t = run.GetAdjustedRealTime();
-      if (run.run_type == Run::RT_Aggregate) {
-        if (run.aggregate_name == "median") median_[name] = t;
-      } else if (!median_.count(name) || single_.count(name)) {
-        single_[name] = t;
-        median_[name] = t;
-      }
-    }
-  }
   void Finalize() override {
     ConsoleReporter::Finalize();
     std::printf("\nRatios of median times (same run):\n");
@@ -269,9 +253,6 @@ class RatioReporter : public benchmark::ConsoleReporter {
           "BM_Table1_Sub2_IntersectTriangulate/euclidean:1", "(CGA / Euclidean predicates)");
     std::fflush(stdout);
   }
-
- private:
-  std::map<std::string, double> median_, single_;
 };
 
 void register_all() {

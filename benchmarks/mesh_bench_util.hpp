@@ -8,6 +8,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <string>
+#include <vector>
 
 #include "conform/mesh/procedural_arm.hpp"
 
@@ -51,5 +54,34 @@ inline void speedup(benchmark::State& state, double paper_seconds, double total_
   state.counters["paper_ms"] = paper_seconds * 1e3;
   state.counters["speedup"] = paper_seconds / ours;
 }
+
+/// Collects the median manual (real) time of every benchmark, under its name without the
+/// "/iterations:N" and "/manual_time" tags (a single run stands for its median); a derived
+/// reporter prints its ratios in Finalize().
+class ManualTimeMedians : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    ConsoleReporter::ReportRuns(runs);
+    for (const auto& run : runs) {
+      std::string name = run.run_name.str();
+      for (const char* tag : {"/iterations:", "/manual_time"})
+        if (const auto at = name.find(tag); at != std::string::npos)
+          name.erase(at, name.find('/', at + 1) - at);
+      const double t = run.GetAdjustedRealTime();
+      if (run.run_type == Run::RT_Aggregate) {
+        if (run.aggregate_name == "median") median_[name] = t;
+      } else if (!median_.count(name) || single_.count(name)) {
+        single_[name] = t;
+        median_[name] = t;
+      }
+    }
+  }
+
+ protected:
+  std::map<std::string, double> median_;
+
+ private:
+  std::map<std::string, double> single_;
+};
 
 }  // namespace conform::bench

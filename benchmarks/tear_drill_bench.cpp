@@ -172,21 +172,8 @@ void segment_query(benchmark::State& state, int faces, int mode) {
 }
 
 // Ratios of median manual times, measured in the same run.
-class RatioReporter : public benchmark::ConsoleReporter {
+class RatioReporter : public conform::bench::ManualTimeMedians {
  public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    ConsoleReporter::ReportRuns(runs);
-    for (const auto& run : runs) {
-      const std::string name = run.run_name.str();
-      const double t = run.GetAdjustedRealTime();
-      if (run.run_type == Run::RT_Aggregate) {
-        if (run.aggregate_name == "median") median_[name] = t;
-      } else if (!median_.count(name) || single_.count(name)) {
-        single_[name] = t;
-        median_[name] = t;
-      }
-    }
-  }
   void Finalize() override {
     ConsoleReporter::Finalize();
     std::printf("\nRatios of median times (same run; < 1: faster than the scan):\n");
@@ -203,9 +190,6 @@ class RatioReporter : public benchmark::ConsoleReporter {
     }
     std::fflush(stdout);
   }
-
- private:
-  std::map<std::string, double> median_, single_;
 };
 
 void register_all() {
