@@ -117,6 +117,7 @@ TEST(PluginStability, ThousandRandomEventsOnARunningArm) {
                   body.vertex_count() - vertices_before, body.piece_count(),
                   mesh::label_pieces(body.mesh()).count);
     }
+    ASSERT_EQ(conform::test::bullet_internals_problem(body), "") << "event " << e;
     w.step();
     ASSERT_NEAR(body.total_mass(), mass, 1e-9 * mass) << "event " << e;
     for (std::int32_t v = 0; v < body.vertex_count(); ++v) {

@@ -78,6 +78,7 @@ void expect_conserved(const bullet::SkinnedSoftBody& body, const Snapshot& befor
 // Every Bullet piece mirrors the mesh: the same faces, one link per edge with our rest length,
 // one node per vertex, faces of a piece connected, pieces = the mesh's connected pieces.
 void expect_mirrors_mesh(const bullet::SkinnedSoftBody& body, const char* what) {
+  EXPECT_EQ(conform::test::bullet_internals_problem(body), "") << what;
   const auto& m = body.mesh();
   std::multiset<std::array<std::int32_t, 3>> mesh_faces, bullet_faces;
   auto canonical = [](std::array<std::int32_t, 3> f) {

@@ -8,7 +8,9 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cmath>
 #include <map>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -83,6 +85,72 @@ inline BendingCheck check_bending(const bullet::SkinnedSoftBody& body) {
         --it->second;
     }
   return out;
+}
+
+/// Bullet's own invariants in every piece, which its per-step code relies on without checks:
+/// each node has a leaf of the body's node tree (m_ndbvt) pointing back at it, the tree holds
+/// exactly those leaves and every internal volume contains its children's; faces and links
+/// point at nodes and materials of their own body; link constants match the rest lengths and
+/// masses (c0 = (1/m_a + 1/m_b) / kLST, c1 = rl²); and no edit asked Bullet for its whole-body
+/// reset (m_bUpdateRtCst), which would wipe the plugin's rest lengths. Returns the first
+/// violation found, or an empty string.
+inline std::string bullet_internals_problem(const bullet::SkinnedSoftBody& body) {
+  for (btSoftBody* sb : body.pieces()) {
+    const int n = sb->m_nodes.size();
+    const btSoftBody::Node* first = n ? &sb->m_nodes[0] : nullptr;
+    auto own_node = [&](const btSoftBody::Node* p) { return n && p >= first && p < first + n; };
+    auto own_material = [&](const btSoftBody::Material* m) {
+      for (int i = 0; i < sb->m_materials.size(); ++i)
+        if (sb->m_materials[i] == m) return true;
+      return false;
+    };
+    if (sb->m_bUpdateRtCst) return "a body awaits Bullet's whole-body reset";
+    if (sb->m_ndbvt.m_leaves != n) return "node tree leaf count != node count";
+    if ((sb->m_ndbvt.m_root == nullptr) != (n == 0)) return "node tree root vs node count";
+    for (int i = 0; i < n; ++i) {
+      const btSoftBody::Node& node = sb->m_nodes[i];
+      if (!node.m_leaf || !node.m_leaf->isleaf() || node.m_leaf->data != &node)
+        return "node without its own tree leaf";
+      const btDbvtNode* up = node.m_leaf;
+      while (up->parent) up = up->parent;
+      if (up != sb->m_ndbvt.m_root) return "node leaf outside its body's tree";
+      if (!own_material(node.m_material)) return "node material of another body";
+    }
+    if (sb->m_ndbvt.m_root) {
+      int leaves = 0;
+      std::vector<const btDbvtNode*> stack{sb->m_ndbvt.m_root};
+      while (!stack.empty()) {
+        const btDbvtNode* t = stack.back();
+        stack.pop_back();
+        if (t->isleaf()) {
+          ++leaves;
+          continue;
+        }
+        for (const btDbvtNode* c : t->childs) {
+          if (c->parent != t) return "node tree child with another parent";
+          if (!t->volume.Contain(c->volume)) return "node tree volume misses a child";
+          stack.push_back(c);
+        }
+      }
+      if (leaves != n) return "node tree reaches a different number of leaves";
+    }
+    for (int i = 0; i < sb->m_faces.size(); ++i) {
+      const auto& f = sb->m_faces[i];
+      for (const auto* p : f.m_n)
+        if (!own_node(p)) return "face node outside its body";
+      if (!own_material(f.m_material)) return "face material of another body";
+    }
+    for (int i = 0; i < sb->m_links.size(); ++i) {
+      const auto& l = sb->m_links[i];
+      if (!own_node(l.m_n[0]) || !own_node(l.m_n[1])) return "link node outside its body";
+      if (!own_material(l.m_material)) return "link material of another body";
+      const double c0 = double(l.m_n[0]->m_im + l.m_n[1]->m_im) / double(l.m_material->m_kLST);
+      if (std::abs(double(l.m_c0) - c0) > 1e-5 * (1 + c0)) return "link c0 off its masses";
+      const double c1 = double(l.m_rl) * double(l.m_rl);
+      if (std::abs(double(l.m_c1) - c1) > 1e-5 * (1e-12 + c1)) return "link c1 != rl²";
+    }
+  }
+  return {};
 }
 
 }  // namespace conform::test

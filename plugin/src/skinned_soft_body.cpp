@@ -84,6 +84,67 @@ std::int32_t third_vertex(const mesh::Face& f, std::int32_t a, std::int32_t b) {
   return -1;
 }
 
+// Spreads the low 10 bits of x to every third bit (Morton code helper).
+std::uint32_t spread_bits(std::uint32_t x) {
+  x &= 0x3ffu;
+  x = (x | (x << 16)) & 0x030000ffu;
+  x = (x | (x << 8)) & 0x0300f00fu;
+  x = (x | (x << 4)) & 0x030c30c3u;
+  x = (x | (x << 2)) & 0x09249249u;
+  return x;
+}
+
+// Builds the node tree (m_ndbvt) of a body whose nodes have no leaves yet, in one pass: leaves
+// as appendNode makes them (the node's position, the body's margin), joined in Morton order
+// into a balanced tree. One insert per node walks the growing tree and costs several times
+// more. Tree nodes come from btAlignedAlloc, as btDbvt's own (it frees them).
+void build_node_tree(btSoftBody& body) {
+  const int n = body.m_nodes.size();
+  if (n == 0) return;
+  const btScalar margin = body.getCollisionShape()->getMargin();
+  btVector3 lo = body.m_nodes[0].m_x, hi = lo;
+  for (int i = 1; i < n; ++i) {
+    lo.setMin(body.m_nodes[i].m_x);
+    hi.setMax(body.m_nodes[i].m_x);
+  }
+  const btVector3 extent = hi - lo;
+  const btScalar size = std::max({extent.x(), extent.y(), extent.z(), btScalar(1e-9)});
+  const btScalar scale = btScalar(1023) / size;
+  std::vector<std::pair<std::uint32_t, int>> order(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    const btVector3 q = (body.m_nodes[i].m_x - lo) * scale;
+    order[static_cast<std::size_t>(i)] = {spread_bits(std::uint32_t(q.x())) |
+                                              (spread_bits(std::uint32_t(q.y())) << 1) |
+                                              (spread_bits(std::uint32_t(q.z())) << 2),
+                                          i};
+  }
+  std::sort(order.begin(), order.end());
+  auto make = [](btDbvtNode* parent) {
+    auto* node = new (btAlignedAlloc(sizeof(btDbvtNode), 16)) btDbvtNode();
+    node->parent = parent;
+    return node;
+  };
+  auto build = [&](auto&& self, int first, int count, btDbvtNode* parent) -> btDbvtNode* {
+    btDbvtNode* node = make(parent);
+    if (count == 1) {
+      btSoftBody::Node& leaf = body.m_nodes[order[static_cast<std::size_t>(first)].second];
+      node->volume = btDbvtVolume::FromCR(leaf.m_x, margin);
+      node->data = &leaf;
+      node->childs[1] = nullptr;
+      leaf.m_leaf = node;
+      return node;
+    }
+    const int half = count / 2;
+    node->childs[0] = self(self, first, half, node);
+    node->childs[1] = self(self, first + half, count - half, node);
+    Merge(node->childs[0]->volume, node->childs[1]->volume, node->volume);
+    return node;
+  };
+  btDbvt& tree = body.m_ndbvt;
+  tree.m_root = build(build, 0, n, nullptr);
+  tree.m_leaves = n;
+}
+
 }  // namespace
 
 SkinnedSoftBody::SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
@@ -172,6 +233,9 @@ SkinnedSoftBody::Piece& SkinnedSoftBody::new_piece() {
   body.m_cfg.piterations = material_.position_iterations;
   body.getCollisionShape()->setMargin(btScalar(material_.margin));
   body.setActivationState(DISABLE_DEACTIVATION);
+  // A new btSoftBody asks for Bullet's whole-body reset at its first step; the plugin writes
+  // every constant of what it adds (rest lengths, link constants, areas), so none is needed.
+  body.m_bUpdateRtCst = false;
   add_(&body);
   pieces_.push_back(std::move(piece));
   ++stats_.new_pieces;
@@ -182,7 +246,7 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
   const auto n = static_cast<std::size_t>(m.vertex_count());
   // Room for edits to grow the per-vertex and per-face tables in place (a reallocation would
   // copy the whole table during an edit).
-  for (auto* table : {&piece_of_, &node_of_, &detached_slot_, &search_label_})
+  for (auto* table : {&piece_of_, &node_of_, &detached_slot_, &search_label_, &move_slot_})
     table->reserve(2 * n);
   for (auto* table : {&area_mark_, &seed_mark_, &pinned_, &kinematic_}) table->reserve(2 * n);
   mass_.reserve(2 * n);
@@ -401,6 +465,12 @@ void SkinnedSoftBody::remove_face_from_bullet(std::int32_t f) {
       bend_dirty_.emplace_back(a, b);
     }
   }
+  remove_face_slot(f);
+  ++stats_.removed_faces;
+}
+
+void SkinnedSoftBody::remove_face_slot(std::int32_t f) {
+  const std::int32_t p = face_piece_[static_cast<std::size_t>(f)];
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
   const int slot = face_slot_[static_cast<std::size_t>(f)], last = body.m_faces.size() - 1;
@@ -415,7 +485,6 @@ void SkinnedSoftBody::remove_face_from_bullet(std::int32_t f) {
   piece.face_id.pop_back();
   face_piece_[static_cast<std::size_t>(f)] = -1;
   face_slot_[static_cast<std::size_t>(f)] = -1;
-  ++stats_.removed_faces;
 }
 
 void SkinnedSoftBody::add_link(std::int32_t p, std::int32_t u, std::int32_t v, double rest) {
@@ -545,6 +614,154 @@ void SkinnedSoftBody::refresh_bending(std::int32_t a, std::int32_t b) {
   double rest = kept_rest(a, b, std::min(c, d), std::max(c, d), true);
   if (rest < 0) rest = (1 - material_.pretension) * (position(c) - position(d)).norm();
   add_bending(p, a, b, c, d, rest);
+}
+
+void SkinnedSoftBody::remove_nodes_highest_first(std::span<const std::int32_t> vertices) {
+  // The last nodes of a body are popped without a swap (and without re-pointing).
+  std::vector<std::int32_t> order(vertices.begin(), vertices.end());
+  std::sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) {
+    return node_of_[static_cast<std::size_t>(x)] > node_of_[static_cast<std::size_t>(y)];
+  });
+  for (const auto v : order) remove_node(v);
+}
+
+std::int32_t SkinnedSoftBody::move_to_new_piece(std::span<const std::int32_t> moving,
+                                                std::int32_t joining, std::int32_t added_faces) {
+  // Every face of a moving vertex moves (the vertices are a whole connected piece), and with
+  // them every edge and bending link touching them. Nodes, faces and links are copied whole,
+  // so that state, rest lengths, link constants and face areas carry over bit-exact, with their
+  // node pointers re-aimed; nothing is recomputed, and Bullet's append functions (which zero
+  // and copy every element, and set the whole-body reset) are not used.
+  const auto n = static_cast<int>(moving.size());
+  move_slot_.resize(piece_of_.size(), -1);
+  std::vector<std::int32_t> sources;  // bodies the nodes leave (normally one)
+  for (int i = 0; i < n; ++i) {
+    const auto v = static_cast<std::size_t>(moving[std::size_t(i)]);
+    move_slot_[v] = i;
+    if (std::find(sources.begin(), sources.end(), piece_of_[v]) == sources.end())
+      sources.push_back(piece_of_[v]);
+  }
+  std::vector<std::int32_t> faces;  // mesh faces, each once (taken at its first vertex)
+  faces.reserve(std::size_t(2 * n + 16));
+  for (const auto v : moving)
+    for (const auto f : vertex_faces_[static_cast<std::size_t>(v)])
+      if (faces_[static_cast<std::size_t>(f)][0] == v &&
+          face_piece_[static_cast<std::size_t>(f)] >= 0)
+        faces.push_back(f);
+  // Links to move, marked per source body. Found through the faces' edges (two hash look-ups
+  // per edge) or, when the moving nodes are a good part of their body, by one pass over its
+  // links (a link moves iff it touches a moving node), which is then cheaper.
+  const bool bending = material_.bending_stiffness > 0;
+  std::vector<std::vector<std::uint8_t>> marks(sources.size());
+  std::size_t link_count = 0;
+  for (std::size_t s = 0; s < sources.size(); ++s) {
+    const Piece& from = *pieces_[static_cast<std::size_t>(sources[s])];
+    const btSoftBody& old = *from.body;
+    auto& mark = marks[s];
+    mark.assign(std::size_t(old.m_links.size()), 0);
+    if (4 * std::size_t(n) >= std::size_t(old.m_nodes.size())) {
+      for (int li = 0; li < old.m_links.size(); ++li) {
+        const auto w = from.node_vertex[std::size_t(old.m_links[li].m_n[0] - &old.m_nodes[0])];
+        if (move_slot_[static_cast<std::size_t>(w)] >= 0) mark[std::size_t(li)] = 1, ++link_count;
+      }
+      continue;
+    }
+    auto take = [&](std::int32_t li) {
+      if (li >= 0 && !mark[static_cast<std::size_t>(li)])
+        mark[static_cast<std::size_t>(li)] = 1, ++link_count;
+    };
+    for (const auto f : faces) {
+      if (face_piece_[static_cast<std::size_t>(f)] != sources[s]) continue;
+      const auto& tri = faces_[static_cast<std::size_t>(f)];
+      for (int k = 0; k < 3; ++k) {
+        const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
+        take(edge_link_.find(a, b));
+        if (bending) take(bend_link_.find(a, b));
+      }
+    }
+  }
+
+  Piece& into = new_piece();
+  const auto into_index = std::int32_t(pieces_.size()) - 1;
+  btSoftBody& body = *into.body;
+  // An empty body: reserving moves nothing that is pointed to. Room for what this change still
+  // adds (new nodes joining, added faces and their links), little more: Bullet's allocator
+  // zeroes every block it hands out (twice), so headroom is not free.
+  const int node_room = n + joining + 16, face_room = int(faces.size()) + added_faces + 16,
+            link_room = int(link_count) + 3 * added_faces * (bending ? 2 : 1) + 16;
+  body.m_nodes.reserve(node_room);
+  body.m_faces.reserve(face_room);
+  body.m_links.reserve(link_room);
+  into.node_vertex.reserve(std::size_t(node_room));
+  into.face_id.reserve(std::size_t(face_room));
+  into.rest.reserve(std::size_t(link_room));
+  into.link_key.reserve(std::size_t(link_room));
+  into.link_bend.reserve(std::size_t(link_room));
+  btSoftBody::Material* const material = body.m_materials[0];
+  btSoftBody::Material* const bending_material =
+      body.m_materials.size() > 1 ? body.m_materials[1] : material;
+
+  // Nodes (never reallocated: reserved above); node i is moving[i].
+  for (int i = 0; i < n; ++i) {
+    const auto v = static_cast<std::size_t>(moving[std::size_t(i)]);
+    body.m_nodes.push_back(body_of(moving[std::size_t(i)])->m_nodes[node_of_[v]]);
+    btSoftBody::Node& node = body.m_nodes[i];
+    node.m_leaf = nullptr;
+    node.m_material = material;
+    into.node_vertex.push_back(moving[std::size_t(i)]);
+  }
+  // Faces: copied, then out of the old body (swap-with-last).
+  for (const auto f : faces) {
+    const auto fi = static_cast<std::size_t>(f);
+    body.m_faces.push_back(
+        pieces_[static_cast<std::size_t>(face_piece_[fi])]->body->m_faces[face_slot_[fi]]);
+    btSoftBody::Face& face = body.m_faces[body.m_faces.size() - 1];
+    for (int k = 0; k < 3; ++k)
+      face.m_n[k] = &body.m_nodes[move_slot_[static_cast<std::size_t>(faces_[fi][std::size_t(k)])]];
+    face.m_leaf = nullptr;
+    face.m_material = material;
+    remove_face_slot(f);
+    face_piece_[fi] = into_index;
+    face_slot_[fi] = body.m_faces.size() - 1;
+    into.face_id.push_back(f);
+  }
+  // Links: copied, then out of the old body, highest index first (the tail is popped without
+  // a swap). Their keys are entered once all have left (an old entry's removal must not meet
+  // a new one).
+  for (std::size_t s = 0; s < sources.size(); ++s) {
+    const std::int32_t p = sources[s];
+    const Piece& from = *pieces_[static_cast<std::size_t>(p)];
+    for (auto li = std::int32_t(marks[s].size()); li-- > 0;) {
+      if (!marks[s][static_cast<std::size_t>(li)]) continue;
+      const auto l = static_cast<std::size_t>(li);
+      body.m_links.push_back(from.body->m_links[li]);
+      btSoftBody::Link& link = body.m_links[body.m_links.size() - 1];
+      for (auto& node : link.m_n) {
+        const auto w = from.node_vertex[static_cast<std::size_t>(node - &from.body->m_nodes[0])];
+        node = &body.m_nodes[move_slot_[static_cast<std::size_t>(w)]];
+      }
+      link.m_material = from.link_bend[l] ? bending_material : material;
+      into.rest.push_back(from.rest[l]);
+      into.link_key.push_back(from.link_key[l]);
+      into.link_bend.push_back(from.link_bend[l]);
+      into.bending += from.link_bend[l];
+      remove_link(p, li);
+    }
+  }
+  stats_.removed_links -= std::int32_t(link_count);  // moved, not removed
+  for (std::size_t i = 0; i < into.link_key.size(); ++i)
+    (into.link_bend[i] ? bend_link_ : edge_link_)
+        .insert(into.link_key[i].first, into.link_key[i].second, std::int32_t(i), true);
+  remove_nodes_highest_first(moving);
+  for (int i = 0; i < n; ++i) {
+    const auto v = static_cast<std::size_t>(moving[std::size_t(i)]);
+    piece_of_[v] = into_index;
+    node_of_[v] = i;
+    move_slot_[v] = -1;
+  }
+  build_node_tree(body);
+  stats_.moved_nodes += n;
+  return into_index;
 }
 
 void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
@@ -850,15 +1067,11 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       if (p >= 0 && p != owner[c]) moving.push_back(v);
     }
     if (moving.empty()) continue;
-    const bool fresh = owner[c] < 0;
-    if (fresh) {
-      btSoftBody& body = *new_piece().body;
-      owner[c] = std::int32_t(pieces_.size()) - 1;
-      // An empty body: reserving moves nothing that is pointed to.
-      const auto n = int(moving.size());
-      body.m_nodes.reserve(n);
-      body.m_faces.reserve(2 * n + 16);
-      body.m_links.reserve(3 * n + 16);
+    if (owner[c] < 0) {
+      // A piece of its own: copied whole into a new body.
+      owner[c] = move_to_new_piece(moving, std::int32_t(components[c].size() - moving.size()),
+                                   std::int32_t(pending.size()));
+      continue;
     }
     std::vector<btSoftBody::Node> state;
     for (const auto v : moving) {
@@ -881,52 +1094,15 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       }
       state.push_back(body_of(v)->m_nodes[node_of_[static_cast<std::size_t>(v)]]);
     }
-    {
-      // Highest node first: the last nodes of a body are popped without a swap.
-      std::vector<std::int32_t> order = moving;
-      std::sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) {
-        return node_of_[static_cast<std::size_t>(x)] > node_of_[static_cast<std::size_t>(y)];
-      });
-      for (const auto v : order) remove_node(v);
-    }
-    Piece& into = *pieces_[static_cast<std::size_t>(owner[c])];
-    btSoftBody& body = *into.body;
-    if (fresh && body.m_nodes.capacity() >= int(moving.size())) {
-      // Into the new (reserved, so never reallocated) body: the nodes are copied whole (x, v
-      // and every other state bit-exact), then their tree leaves are inserted in bit-reversed
-      // order, which keeps Bullet's incrementally built node tree shallow (neighbours inserted
-      // one after the other make a deep one, and every later insert walks it).
-      for (std::size_t i = 0; i < moving.size(); ++i) {
-        body.m_nodes.push_back(state[i]);
-        btSoftBody::Node& node = body.m_nodes[body.m_nodes.size() - 1];
-        node.m_leaf = nullptr;
-        node.m_material = body.m_materials[0];
-        const auto v = static_cast<std::size_t>(moving[i]);
-        piece_of_[v] = owner[c];
-        node_of_[v] = body.m_nodes.size() - 1;
-        into.node_vertex.push_back(moving[i]);
-      }
-      const btScalar margin = body.getCollisionShape()->getMargin();
-      const auto n = static_cast<std::uint32_t>(moving.size());
-      int bits = 0;
-      while ((1u << bits) < n) ++bits;
-      for (std::uint32_t k = 0; k < (1u << bits); ++k) {
-        std::uint32_t r = 0;
-        for (int b = 0; b < bits; ++b) r |= ((k >> b) & 1u) << (bits - 1 - b);
-        if (r >= n) continue;
-        btSoftBody::Node& node = body.m_nodes[int(r)];
-        node.m_leaf = body.m_ndbvt.insert(btDbvtVolume::FromCR(node.m_x, margin), &node);
-      }
-    } else {
-      for (std::size_t i = 0; i < moving.size(); ++i) {
-        add_node(owner[c], moving[i], to_eigen(state[i].m_x), to_eigen(state[i].m_v));
-        // Bit-exact copy (the double round trip is exact, but say so in code).
-        btSoftBody::Node& node =
-            body_of(moving[i])->m_nodes[node_of_[static_cast<std::size_t>(moving[i])]];
-        node.m_x = state[i].m_x;
-        node.m_q = state[i].m_q;
-        node.m_v = state[i].m_v;
-      }
+    remove_nodes_highest_first(moving);
+    for (std::size_t i = 0; i < moving.size(); ++i) {
+      add_node(owner[c], moving[i], to_eigen(state[i].m_x), to_eigen(state[i].m_v));
+      // Bit-exact copy (the double round trip is exact, but say so in code).
+      btSoftBody::Node& node =
+          body_of(moving[i])->m_nodes[node_of_[static_cast<std::size_t>(moving[i])]];
+      node.m_x = state[i].m_x;
+      node.m_q = state[i].m_q;
+      node.m_v = state[i].m_v;
     }
     stats_.moved_nodes += std::int32_t(moving.size());
   }

@@ -218,6 +218,12 @@ class SkinnedSoftBody {
                 const Eigen::Vector3d& v);
   void add_face(std::int32_t piece, std::int32_t face);
   void remove_face_from_bullet(std::int32_t face);
+  void remove_face_slot(std::int32_t face);  // out of its body only (no links, no stats)
+  void remove_nodes_highest_first(std::span<const std::int32_t> vertices);
+  /// Moves a whole connected piece (its vertices in Bullet) into a new body, with room for
+  /// `joining` nodes and `added_faces` faces still to come in this change; the body's index.
+  std::int32_t move_to_new_piece(std::span<const std::int32_t> moving, std::int32_t joining,
+                                 std::int32_t added_faces);
   void remove_link(std::int32_t piece, std::int32_t link);
   void add_link(std::int32_t piece, std::int32_t u, std::int32_t v, double rest);
   void add_bending(std::int32_t piece, std::int32_t a, std::int32_t b, std::int32_t c,
@@ -272,6 +278,7 @@ class SkinnedSoftBody {
   std::int32_t detached_count_ = 0;
   // Split search scratch (per vertex, −1 between searches).
   std::vector<std::int32_t> search_label_;
+  std::vector<std::int32_t> move_slot_;  // per vertex: its node in a new body (−1 between)
   // Links removed during one change whose link may come back: (a, b, c, d, rest), where (a, b)
   // is the key edge and (c, d) the end vertices (equal to (a, b) for an edge link).
   std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, double>> relink_;
