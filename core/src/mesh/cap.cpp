@@ -1,7 +1,5 @@
 #include "conform/mesh/cap.hpp"
 
-#include "conform/mesh/adjacency.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -42,41 +40,80 @@ double cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Ve
 // Ear clipping of the polygon `poly` (indices into p, possibly repeating a vertex where a
 // bridge enters and leaves a hole), counter-clockwise; appends counter-clockwise triangles.
 // False when no ear can be found (not simple).
-bool ear_clip(const Pts& p, std::vector<std::int32_t> idx,
+//
+// The polygon is a circular linked list, so clipping is O(1), and only reflex (or flat)
+// vertices are tested against a candidate ear: a convex vertex cannot lie inside an ear
+// unless a reflex one does too. A nearly convex loop, the usual cut section, is therefore
+// clipped in O(n) rather than O(n²).
+bool ear_clip(const Pts& p, const std::vector<std::int32_t>& poly,
               std::vector<std::array<std::int32_t, 3>>& out) {
-  if (idx.size() < 3) return false;
-  auto P = [&](std::int32_t i) -> const Eigen::Vector2d& { return p[static_cast<std::size_t>(i)]; };
+  const auto m = static_cast<std::int32_t>(poly.size());
+  if (m < 3) return false;
+  auto P = [&](std::int32_t node) -> const Eigen::Vector2d& {
+    return p[static_cast<std::size_t>(poly[static_cast<std::size_t>(node)])];
+  };
   double scale = 0;
-  for (auto i : idx) scale = std::max(scale, P(i).cwiseAbs().maxCoeff());
+  for (auto i : poly) scale = std::max(scale, p[static_cast<std::size_t>(i)].cwiseAbs().maxCoeff());
   const double eps = 1e-14 * scale * scale;
   const std::size_t first = out.size();
+  std::vector<std::int32_t> prev(static_cast<std::size_t>(m)), next(static_cast<std::size_t>(m));
+  std::vector<std::uint8_t> reflex(static_cast<std::size_t>(m)),
+      alive(static_cast<std::size_t>(m), 1);
+  std::vector<std::int32_t> blockers;  // nodes that were reflex or flat when last looked at
+  auto at = [](std::vector<std::int32_t>& v, std::int32_t k) -> std::int32_t& {
+    return v[static_cast<std::size_t>(k)];
+  };
+  auto update = [&](std::int32_t k) {
+    const bool was = reflex[static_cast<std::size_t>(k)] != 0;
+    const bool now = !(cross(P(at(prev, k)), P(k), P(at(next, k))) > eps);
+    reflex[static_cast<std::size_t>(k)] = now;
+    if (now && !was) blockers.push_back(k);
+  };
+  for (std::int32_t k = 0; k < m; ++k) at(prev, k) = (k + m - 1) % m, at(next, k) = (k + 1) % m;
+  for (std::int32_t k = 0; k < m; ++k) update(k);
   // Round robin: after an ear is clipped the search resumes two vertices on, so that a convex
   // polygon is cut into halves, quarters, … rather than into a fan (fewer flips afterwards).
-  std::size_t start = 0;
-  while (idx.size() > 3) {
-    const std::size_t m = idx.size();
-    bool clipped = false;
-    for (std::size_t step = 0; step < m && !clipped; ++step) {
-      const std::size_t i = (start + step) % m;
-      const std::int32_t a = idx[(i + m - 1) % m], b = idx[i], c = idx[(i + 1) % m];
-      if (cross(P(a), P(b), P(c)) <= eps) continue;  // reflex or flat: not an ear
-      bool blocked = false;
-      for (std::size_t j = 0; j < m && !blocked; ++j) {
-        const std::int32_t q = idx[j];
-        if (q == a || q == b || q == c || P(q) == P(a) || P(q) == P(b) || P(q) == P(c)) continue;
-        blocked = cross(P(a), P(b), P(q)) >= 0 && cross(P(b), P(c), P(q)) >= 0 &&
-                  cross(P(c), P(a), P(q)) >= 0;
+  std::int32_t left = m, cur = 0, misses = 0;
+  while (left > 3) {
+    if (misses >= left) return false;  // a whole round without an ear
+    const std::int32_t b = cur, a = at(prev, b), c = at(next, b);
+    bool ear = reflex[static_cast<std::size_t>(b)] == 0;
+    if (ear) {
+      const Eigen::Vector2d &A = P(a), &B = P(b), &C = P(c);
+      for (const std::int32_t q : blockers) {
+        if (!alive[static_cast<std::size_t>(q)] || !reflex[static_cast<std::size_t>(q)] || q == a ||
+            q == b || q == c)
+          continue;
+        const Eigen::Vector2d& Q = P(q);
+        if (Q == A || Q == B || Q == C) continue;
+        if (cross(A, B, Q) >= 0 && cross(B, C, Q) >= 0 && cross(C, A, Q) >= 0) {
+          ear = false;
+          break;
+        }
       }
-      if (blocked) continue;
-      out.push_back({a, b, c});
-      idx.erase(idx.begin() + static_cast<std::ptrdiff_t>(i));
-      start = i + 1;
-      clipped = true;
     }
-    if (!clipped) return false;
+    if (!ear) {
+      cur = c, ++misses;
+      continue;
+    }
+    out.push_back({poly[static_cast<std::size_t>(a)], poly[static_cast<std::size_t>(b)],
+                   poly[static_cast<std::size_t>(c)]});
+    alive[static_cast<std::size_t>(b)] = 0;
+    at(next, a) = c, at(prev, c) = a;
+    --left;
+    update(a), update(c);
+    std::erase_if(blockers, [&](std::int32_t q) {
+      return !alive[static_cast<std::size_t>(q)] || !reflex[static_cast<std::size_t>(q)];
+    });
+    cur = at(next, c), misses = 0;
   }
-  if (cross(P(idx[0]), P(idx[1]), P(idx[2])) > eps) {
-    out.push_back({idx[0], idx[1], idx[2]});
+  const std::int32_t n0 = cur, n1 = at(next, n0), n2 = at(next, n1);
+  const std::array<std::int32_t, 3> idx = {poly[static_cast<std::size_t>(n0)],
+                                           poly[static_cast<std::size_t>(n1)],
+                                           poly[static_cast<std::size_t>(n2)]};
+  auto Q = [&](std::int32_t i) -> const Eigen::Vector2d& { return p[static_cast<std::size_t>(i)]; };
+  if (cross(Q(idx[0]), Q(idx[1]), Q(idx[2])) > eps) {
+    out.push_back(idx);
     return true;
   }
   // The last three are collinear (collinear boundary points, e.g. along a flat face): the
@@ -86,20 +123,67 @@ bool ear_clip(const Pts& p, std::vector<std::int32_t> idx,
     const std::int32_t a = idx[static_cast<std::size_t>(r)],
                        b = idx[static_cast<std::size_t>((r + 1) % 3)],
                        c = idx[static_cast<std::size_t>((r + 2) % 3)];
-    const Eigen::Vector2d ac = P(c) - P(a);
-    const double along = ac.dot(P(b) - P(a));
+    const Eigen::Vector2d ac = Q(c) - Q(a);
+    const double along = ac.dot(Q(b) - Q(a));
     if (!(along > 0 && along < ac.squaredNorm())) continue;  // b is not between a and c
     for (std::size_t t = first; t < out.size(); ++t)
       for (std::size_t k = 0; k < 3; ++k)
         if (out[t][k] == a && out[t][(k + 1) % 3] == c) {
           const std::int32_t d = out[t][(k + 2) % 3];
-          if (cross(P(a), P(b), P(d)) <= eps || cross(P(b), P(c), P(d)) <= eps) return false;
+          if (cross(Q(a), Q(b), Q(d)) <= eps || cross(Q(b), Q(c), Q(d)) <= eps) return false;
           out[t] = {a, b, d};
           out.push_back({b, c, d});
           return true;
         }
   }
   return false;
+}
+
+// A strictly convex polygon (every turn > eps, counter-clockwise) triangulated as a strip from
+// its vertex farthest from the centroid (an end of its long axis), each step taking the
+// Delaunay diagonal of the quadrilateral at the strip's front. The usual cut section, close to
+// an ellipse, then comes out Delaunay already and the flips after it only confirm it (a
+// balanced ear clipping needs O(n) flips of O(n) cost each there). False when not strictly
+// convex.
+bool convex_strip(const Pts& p, const std::vector<std::int32_t>& poly,
+                  std::vector<std::array<std::int32_t, 3>>& out) {
+  const auto m = static_cast<std::int32_t>(poly.size());
+  if (m < 3) return false;
+  auto P = [&](std::int32_t k) -> const Eigen::Vector2d& {
+    return p[static_cast<std::size_t>(poly[static_cast<std::size_t>(k)])];
+  };
+  double scale = 0;
+  Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+  for (std::int32_t k = 0; k < m; ++k)
+    scale = std::max(scale, P(k).cwiseAbs().maxCoeff()), centroid += P(k);
+  centroid /= m;
+  const double eps = 1e-14 * scale * scale;
+  std::int32_t start = 0;
+  double far = -1;
+  for (std::int32_t k = 0; k < m; ++k) {
+    if (!(cross(P((k + m - 1) % m), P(k), P((k + 1) % m)) > eps)) return false;
+    const double d = (P(k) - centroid).squaredNorm();
+    if (d > far) far = d, start = k;
+  }
+  auto id = [&](std::int32_t k) { return poly[static_cast<std::size_t>(k)]; };
+  std::int32_t r = (start + m - 1) % m, l = (start + 1) % m;
+  out.push_back({id(r), id(start), id(l)});
+  if (m == 3) return true;
+  for (std::int32_t remaining = m - 1; remaining > 3; --remaining) {
+    const std::int32_t ahead = (l + 1) % m, behind = (r + m - 1) % m;
+    // The quadrilateral (behind, r, l, ahead): diagonal (r, ahead) when `ahead` lies inside
+    // the circle through (behind, r, l), else (behind, l).
+    const Eigen::Vector2d u = P(behind) - P(ahead), v = P(r) - P(ahead), w = P(l) - P(ahead);
+    const double in = u.squaredNorm() * (v.x() * w.y() - v.y() * w.x()) -
+                      v.squaredNorm() * (u.x() * w.y() - u.y() * w.x()) +
+                      w.squaredNorm() * (u.x() * v.y() - u.y() * v.x());
+    if (in > 0)
+      out.push_back({id(r), id(l), id(ahead)}), l = ahead;
+    else
+      out.push_back({id(behind), id(r), id(l)}), r = behind;
+  }
+  out.push_back({id(r), id(l), id((l + 1) % m)});
+  return true;
 }
 
 // Joins the clockwise hole `hole` into the counter-clockwise polygon `poly` by a bridge from
@@ -169,58 +253,85 @@ bool bridge(const Pts& p, std::vector<std::int32_t>& poly, const std::vector<std
 // fourth point lies inside the other's circumcircle is flipped, until none is (or a generous
 // flip budget runs out). Edges used once — the loops — never flip, so the result is the
 // constrained Delaunay triangulation of the region (up to ties among cocircular points).
+//
+// Half-edge h = 3 i + k runs from t[first + i][k] to t[first + i][k + 1]; twins are paired
+// once by sorting the undirected edges, then kept up to date across flips (no hashing).
 void delaunay_flips(const Pts& p, std::vector<std::array<std::int32_t, 3>>& t, std::size_t first) {
   const std::size_t n = t.size() - first;
   if (n < 2) return;
   auto P = [&](std::int32_t i) -> const Eigen::Vector2d& { return p[static_cast<std::size_t>(i)]; };
+  auto tri = [&](std::int32_t i) -> std::array<std::int32_t, 3>& {
+    return t[first + static_cast<std::size_t>(i)];
+  };
   double scale = 0;
   for (std::size_t i = first; i < t.size(); ++i)
     for (auto v : t[i]) scale = std::max(scale, P(v).cwiseAbs().maxCoeff());
   const double eps_area = 1e-14 * scale * scale, eps_circle = 1e-12 * std::pow(scale, 4);
-  EdgeMap where;  // directed edge → 3 · triangle + k
-  where.reserve(3 * n);
-  std::vector<std::int32_t> stack;
-  for (std::size_t i = first; i < t.size(); ++i)
-    for (int k = 0; k < 3; ++k) {
-      const auto code = static_cast<std::int32_t>(3 * i + static_cast<std::size_t>(k));
-      where.insert(t[i][static_cast<std::size_t>(k)], t[i][static_cast<std::size_t>((k + 1) % 3)],
-                   code, true);
-      stack.push_back(code);
+  const auto nh = static_cast<std::int32_t>(3 * n);
+  auto from = [&](std::int32_t h) { return tri(h / 3)[static_cast<std::size_t>(h % 3)]; };
+  auto to = [&](std::int32_t h) { return tri(h / 3)[static_cast<std::size_t>((h % 3 + 1) % 3)]; };
+  // Pair twins through per-vertex lists of outgoing half-edges: an inner edge is used exactly
+  // once in each direction (else it is a loop edge, or degenerate, and is kept).
+  std::vector<std::int32_t> twin(static_cast<std::size_t>(nh), -1);
+  {
+    std::vector<std::int32_t> head(p.size(), -1), next_out(static_cast<std::size_t>(nh));
+    for (std::int32_t h = 0; h < nh; ++h) {
+      next_out[static_cast<std::size_t>(h)] = head[static_cast<std::size_t>(from(h))];
+      head[static_cast<std::size_t>(from(h))] = h;
     }
+    auto uses = [&](std::int32_t u, std::int32_t v, std::int32_t& last) {
+      int count = 0;
+      for (std::int32_t g = head[static_cast<std::size_t>(u)]; g >= 0;
+           g = next_out[static_cast<std::size_t>(g)])
+        if (to(g) == v) ++count, last = g;
+      return count;
+    };
+    for (std::int32_t h = 0; h < nh; ++h) {
+      std::int32_t g = -1, same = -1;
+      if (twin[static_cast<std::size_t>(h)] < 0 && uses(to(h), from(h), g) == 1 &&
+          uses(from(h), to(h), same) == 1)
+        twin[static_cast<std::size_t>(h)] = g, twin[static_cast<std::size_t>(g)] = h;
+    }
+  }
+  auto link = [&](std::int32_t x, std::int32_t y) {
+    twin[static_cast<std::size_t>(x)] = y;
+    if (y >= 0) twin[static_cast<std::size_t>(y)] = x;
+  };
   auto incircle = [&](std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d) {
     const Eigen::Vector2d u = P(a) - P(d), v = P(b) - P(d), w = P(c) - P(d);
     return u.squaredNorm() * (v.x() * w.y() - v.y() * w.x()) -
            v.squaredNorm() * (u.x() * w.y() - u.y() * w.x()) +
            w.squaredNorm() * (u.x() * v.y() - u.y() * v.x());
   };
+  std::vector<std::int32_t> stack;
+  stack.reserve(static_cast<std::size_t>(nh));
+  for (std::int32_t h = 0; h < nh; ++h)
+    if (twin[static_cast<std::size_t>(h)] > h) stack.push_back(h);
   std::size_t budget = 20 * n * n + 100;
   while (!stack.empty() && budget-- > 0) {
-    const std::int32_t code = stack.back();
+    const std::int32_t h = stack.back();
     stack.pop_back();
-    const auto i = static_cast<std::size_t>(code / 3);
-    const int k = code % 3;
-    const std::int32_t a = t[i][static_cast<std::size_t>(k)],
-                       b = t[i][static_cast<std::size_t>((k + 1) % 3)],
-                       c = t[i][static_cast<std::size_t>((k + 2) % 3)];
-    if (where.find(a, b) != code) continue;  // stale: this triangle changed since
-    const std::int32_t other = where.find(b, a);
-    if (other < 0) continue;  // a loop edge
-    const auto j = static_cast<std::size_t>(other / 3);
-    const std::int32_t d = t[j][static_cast<std::size_t>((other % 3 + 2) % 3)];
+    const std::int32_t o = twin[static_cast<std::size_t>(h)];
+    if (o < 0) continue;  // a loop edge
+    const std::int32_t i = h / 3, k = h % 3, j = o / 3, l = o % 3;
+    std::array<std::int32_t, 3>&ti = tri(i), &tj = tri(j);
+    const std::int32_t a = ti[static_cast<std::size_t>(k)],
+                       b = ti[static_cast<std::size_t>((k + 1) % 3)],
+                       c = ti[static_cast<std::size_t>((k + 2) % 3)],
+                       d = tj[static_cast<std::size_t>((l + 2) % 3)];
     if (!(incircle(a, b, c, d) > eps_circle)) continue;
     // (a, b, c) and (b, a, d) → (a, d, c) and (d, b, c), when both turn counter-clockwise.
     if (!(cross(P(a), P(d), P(c)) > eps_area) || !(cross(P(d), P(b), P(c)) > eps_area)) continue;
-    where.erase(a, b, code);
-    where.erase(b, a, other);
-    t[i] = {a, d, c};
-    t[j] = {d, b, c};
-    for (const std::size_t x : {i, j})
-      for (int m = 0; m < 3; ++m) {
-        const auto cm = static_cast<std::int32_t>(3 * x + static_cast<std::size_t>(m));
-        where.insert(t[x][static_cast<std::size_t>(m)], t[x][static_cast<std::size_t>((m + 1) % 3)],
-                     cm, true);
-        stack.push_back(cm);
-      }
+    const std::int32_t bc = twin[static_cast<std::size_t>(3 * i + (k + 1) % 3)],
+                       ca = twin[static_cast<std::size_t>(3 * i + (k + 2) % 3)],
+                       ad = twin[static_cast<std::size_t>(3 * j + (l + 1) % 3)],
+                       db = twin[static_cast<std::size_t>(3 * j + (l + 2) % 3)];
+    ti = {a, d, c};
+    tj = {d, b, c};
+    link(3 * i, ad), link(3 * i + 1, 3 * j + 2), link(3 * i + 2, ca);
+    link(3 * j, db), link(3 * j + 1, bc);
+    for (const std::int32_t e : {3 * i, 3 * i + 2, 3 * j, 3 * j + 1})
+      if (twin[static_cast<std::size_t>(e)] >= 0) stack.push_back(e);
   }
 }
 
@@ -270,7 +381,8 @@ bool ear_clip_section(const std::vector<Pts>& loops, SectionTriangulation& out) 
         out.problem = "a hole of the section could not be bridged to its outer loop";
         return false;
       }
-    if (!ear_clip(p, std::move(poly), out.triangles)) {
+    if (!(holes.empty() && convex_strip(p, poly, out.triangles)) &&
+        !ear_clip(p, poly, out.triangles)) {
       out.problem = "a loop whose projection is not a simple polygon";
       return false;
     }

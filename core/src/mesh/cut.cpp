@@ -332,61 +332,87 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
 
   if (!options.cap) return result;
 
-  // Caps. The boundary of the positive side created by the cut: directed edges of positive
-  // pending faces between loop vertices (pre-remap ids) whose reverse no positive face has.
-  auto is_loop_vertex = [&](std::int32_t v) {
-    return v >= nv0 ? v < nv0 + nx : side[static_cast<std::size_t>(v)] == 0;
+  // Caps. Loop vertices (crossing vertices, and original vertices on the plane) get compact
+  // local ids — crossing vertex nv0 + k is k, the i-th vertex of `plane_vertices` is nx + i —
+  // so that the loop bookkeeping is flat arrays rather than hash maps.
+  std::vector<std::int32_t> plane_vertices;
+  plane_vertices.reserve(on_plane.size());
+  for (const auto& [v, unused] : on_plane)
+    if (plane_vertices.empty() || plane_vertices.back() != v) plane_vertices.push_back(v);
+  const auto nloop = static_cast<std::size_t>(nx) + plane_vertices.size();
+  auto local = [&](std::int32_t v) -> std::int32_t {  // −1 when v is not a loop vertex
+    if (v >= nv0) return v < nv0 + nx ? v - nv0 : -1;
+    if (side[static_cast<std::size_t>(v)] != 0) return -1;
+    return nx + static_cast<std::int32_t>(
+                    std::lower_bound(plane_vertices.begin(), plane_vertices.end(), v) -
+                    plane_vertices.begin());
   };
-  EdgeMap plus_edges;  // only edges between loop vertices matter
-  plus_edges.reserve(pending.size());
-  for (const Pending& p : pending)
-    if (p.side > 0)
-      for (int k = 0; k < 3; ++k)
-        if (is_loop_vertex(p.pre[k]) && is_loop_vertex(p.pre[(k + 1) % 3]))
-          plus_edges.insert(p.pre[k], p.pre[(k + 1) % 3], 1);
-  // Copy maps: pre-remap id → the id each side uses; conflicting entries make a loop ambiguous.
-  EdgeMap copy_of;  // key (vertex, side + 1) → id
-  copy_of.reserve(pending.size());
-  std::vector<std::int32_t> ambiguous;
-  for (const Pending& p : pending)
+  auto global = [&](std::int32_t l) {
+    return l < nx ? nv0 + l : plane_vertices[static_cast<std::size_t>(l - nx)];
+  };
+  // Per pending face, its vertices' local ids (−1 for others).
+  std::vector<std::array<std::int32_t, 3>> pending_local(pending.size());
+  for (std::size_t i = 0; i < pending.size(); ++i)
+    for (int k = 0; k < 3; ++k) pending_local[i][k] = local(pending[i].pre[k]);
+  // The id each side uses for a loop vertex; conflicting entries make a loop ambiguous.
+  std::vector<std::int32_t> copy_plus(nloop, -1), copy_minus(nloop, -1);
+  std::vector<std::uint8_t> ambiguous(nloop, 0);
+  for (std::size_t i = 0; i < pending.size(); ++i)
     for (int k = 0; k < 3; ++k) {
-      if (!is_loop_vertex(p.pre[k])) continue;
-      if (!copy_of.insert(p.pre[k], p.side + 1, p.v[k]) &&
-          copy_of.find(p.pre[k], p.side + 1) != p.v[k])
-        ambiguous.push_back(p.pre[k]);
+      const std::int32_t l = pending_local[i][k];
+      if (l < 0) continue;
+      std::int32_t& id =
+          (pending[i].side > 0 ? copy_plus : copy_minus)[static_cast<std::size_t>(l)];
+      if (id < 0)
+        id = pending[i].v[k];
+      else if (id != pending[i].v[k])
+        ambiguous[static_cast<std::size_t>(l)] = 1;
     }
-  std::sort(ambiguous.begin(), ambiguous.end());
-  EdgeMap next;  // boundary edge u → v, keyed (u, 0)
-  next.reserve(pending.size() / 2);
+  // The boundary of the positive side created by the cut: directed edges of positive faces
+  // between loop vertices whose reverse no positive face has.
+  auto edge_key = [](std::int32_t u, std::int32_t w) {
+    return (std::uint64_t(std::uint32_t(u)) << 32) | std::uint32_t(w);
+  };
+  std::vector<std::uint64_t> plus_edges;
+  plus_edges.reserve(pending.size());
+  for (std::size_t i = 0; i < pending.size(); ++i)
+    if (pending[i].side > 0)
+      for (int k = 0; k < 3; ++k) {
+        const std::int32_t u = pending_local[i][k], w = pending_local[i][(k + 1) % 3];
+        if (u >= 0 && w >= 0) plus_edges.push_back(edge_key(u, w));
+      }
+  std::sort(plus_edges.begin(), plus_edges.end());
+  std::vector<std::int32_t> next(nloop, -1);  // boundary edge u → next[u]
   std::vector<std::int32_t> starts;
   bool branching = false;
-  for (const Pending& p : pending) {
-    if (p.side <= 0) continue;
-    for (int k = 0; k < 3; ++k) {
-      const std::int32_t u = p.pre[k], w = p.pre[(k + 1) % 3];
-      if (!is_loop_vertex(u) || !is_loop_vertex(w) || plus_edges.find(w, u) >= 0) continue;
-      if (!next.insert(u, 0, w)) branching = true;
-      starts.push_back(u);
-    }
+  for (const std::uint64_t e : plus_edges) {
+    const auto u = static_cast<std::int32_t>(e >> 32),
+               w = static_cast<std::int32_t>(e & 0xffffffffu);
+    if (std::binary_search(plus_edges.begin(), plus_edges.end(), edge_key(w, u))) continue;
+    std::int32_t& to = next[static_cast<std::size_t>(u)];
+    if (to >= 0)
+      branching = true;
+    else
+      to = w;
+    starts.push_back(u);
   }
-  EdgeMap visited;
-  visited.reserve(starts.size());
+  std::vector<std::uint8_t> visited(nloop, 0);
   std::vector<std::string> problems;
   // Every closed, unambiguous loop goes into one triangulation of the section, in the plane's
   // frame (e1, e2, n), so that loops inside loops make holes and islands.
   const Eigen::Vector3d e1 = n.unitOrthogonal(), e2 = n.cross(e1);
-  std::vector<std::int32_t> ids;  // the section's vertices, loops concatenated
+  std::vector<std::int32_t> ids;  // the section's vertices (local ids), loops concatenated
   std::vector<std::vector<Eigen::Vector2d>> loops2;
   std::vector<std::int32_t> loop;
   for (auto s0 : starts) {
-    if (visited.find(s0, 0) >= 0) continue;
+    if (visited[static_cast<std::size_t>(s0)]) continue;
     loop.clear();
     std::int32_t u = s0;
     bool closed = false;
-    while (u >= 0 && visited.find(u, 0) < 0) {
-      visited.insert(u, 0, 1);
+    while (u >= 0 && !visited[static_cast<std::size_t>(u)]) {
+      visited[static_cast<std::size_t>(u)] = 1;
       loop.push_back(u);
-      u = next.find(u, 0);
+      u = next[static_cast<std::size_t>(u)];
       if (u == s0) closed = true;
     }
     if (!closed) {
@@ -395,7 +421,7 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     }
     ++result.loops;
     bool amb = branching;
-    for (auto v : loop) amb |= std::binary_search(ambiguous.begin(), ambiguous.end(), v);
+    for (auto v : loop) amb |= ambiguous[static_cast<std::size_t>(v)] != 0;
     if (amb) {
       problems.push_back(
           "a cut loop through a vertex where the surface touches the plane in several fans");
@@ -404,7 +430,7 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     auto& p2 = loops2.emplace_back();
     p2.reserve(loop.size());
     for (auto v : loop) {
-      const Eigen::Vector3d x = pos(v);
+      const Eigen::Vector3d x = pos(global(v));
       p2.emplace_back(x.dot(e1), x.dot(e2));
     }
     ids.insert(ids.end(), loop.begin(), loop.end());
@@ -422,9 +448,10 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
       for (const auto& t : section.triangles) {
         Face plus, minus;
         for (int k = 0; k < 3; ++k) {
-          const std::int32_t v = ids[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])];
-          plus[2 - k] = copy_of.find(v, 2);
-          minus[k] = copy_of.find(v, 0);
+          const auto v = static_cast<std::size_t>(
+              ids[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])]);
+          plus[2 - k] = copy_plus[v];
+          minus[k] = copy_minus[v];
         }
         if (plus[0] >= 0 && plus[1] >= 0 && plus[2] >= 0) {
           ch.added_faces.push_back(plus);
