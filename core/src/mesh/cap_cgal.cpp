@@ -10,6 +10,9 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
 
 namespace conform::mesh::detail {
 
@@ -30,22 +33,50 @@ bool cdt_available() {
   return true;
 }
 
-bool cdt_section(const std::vector<std::vector<Eigen::Vector2d>>& loops,
+namespace {
+
+// Input conditioning. A cut section is often symmetric (a tube cut across: points on an
+// ellipse, four of them on a rectangle and so exactly cocircular), and every exact tie of the
+// in-circle predicate sends the filtered kernel into exact arithmetic (tens of µs each). The
+// points are centred on their bounding box (smaller coordinates, tighter filter bounds) and
+// sheared by x += kShear · y: a shear has determinant 1, so it keeps every orientation (the
+// loops, their nesting and the constraint edges) while breaking the cocircularity of such
+// symmetric sets, which the floating-point filter then decides. The triangulation is the
+// constrained Delaunay one of the sheared points, i.e. of the section up to ties within
+// ~kShear of the empty-circle criterion.
+constexpr double kShear = 0x1p-32;  // ≈ 2e-10
+
+bool triangulate(const std::vector<std::vector<Eigen::Vector2d>>& loops, bool condition,
                  SectionTriangulation& out) {
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  if (condition) {
+    Eigen::Vector2d lo = loops[0][0], hi = loops[0][0];
+    for (const auto& l : loops)
+      for (const auto& q : l) lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+    centre = 0.5 * (lo + hi);
+  }
+  const double shear = condition ? kShear : 0.0;
   try {
     Cdt cdt;
     std::vector<std::vector<Cdt::Vertex_handle>> handles(loops.size());
-    std::int32_t id = 0;
-    Cdt::Face_handle hint;
+    std::int32_t first_id = 0;
     for (std::size_t l = 0; l < loops.size(); ++l) {
-      handles[l].reserve(loops[l].size());
-      for (const Eigen::Vector2d& p : loops[l]) {
-        const Cdt::Vertex_handle v = cdt.insert(K::Point_2(p.x(), p.y()), hint);
-        v->info() = id++;
-        hint = v->face();
-        handles[l].push_back(v);
+      // Every point of a convex loop is outside the hull of the earlier ones: inserted in loop
+      // order, each would see a long stretch of hull and restore Delaunay by many flips.
+      // A stride of about n/φ, coprime with n, spreads the insertions around the loop.
+      const auto n = static_cast<std::int64_t>(loops[l].size());
+      std::int64_t stride = std::max<std::int64_t>(1, std::llround(0.618 * static_cast<double>(n)));
+      while (std::gcd(stride, n) != 1) ++stride;
+      handles[l].resize(loops[l].size());
+      for (std::int64_t k = 0, i = 0; k < n; ++k, i = (i + stride) % n) {
+        const Eigen::Vector2d q = loops[l][static_cast<std::size_t>(i)] - centre;
+        const Cdt::Vertex_handle v = cdt.insert(K::Point_2(q.x() + shear * q.y(), q.y()));
+        v->info() = first_id + static_cast<std::int32_t>(i);
+        handles[l][static_cast<std::size_t>(i)] = v;
       }
+      first_id += static_cast<std::int32_t>(n);
     }
+    const std::int32_t id = first_id;
     if (cdt.number_of_vertices() != static_cast<std::size_t>(id)) {
       out.problem = "two loop vertices coincide in the section";
       return false;
@@ -100,6 +131,18 @@ bool cdt_section(const std::vector<std::vector<Eigen::Vector2d>>& loops,
     out.problem = std::string("loops cross or touch in the section (") + e.what() + ")";
     return false;
   }
+}
+
+}  // namespace
+
+bool cdt_section(const std::vector<std::vector<Eigen::Vector2d>>& loops,
+                 SectionTriangulation& out) {
+  if (loops.empty()) return true;
+  // The conditioned points round differently from the given ones: should that make loops
+  // that were apart touch, triangulate the section as given instead.
+  if (triangulate(loops, true, out)) return true;
+  out = SectionTriangulation{};
+  return triangulate(loops, false, out);
 }
 
 }  // namespace conform::mesh::detail
