@@ -3,29 +3,43 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
-#include <deque>
 #include <numbers>
 #include <stdexcept>
-
-#include "conform/mesh/refine.hpp"
 
 namespace conform::mesh {
 
 namespace {
 
 struct Axis {
-  Eigen::Vector3d b, u;  // base and unit direction towards the tip
+  Eigen::Vector3d b, u;    // base and unit direction towards the tip
+  Eigen::Vector3d e1, e2;  // an orthonormal frame of the plane Π, with u right-handed
   double length = 0, r2 = 0;
+  Axis(const DrillTool& tool) : b(tool.base), r2(tool.radius * tool.radius) {
+    length = (tool.tip - tool.base).norm();
+    u = (tool.tip - tool.base) / length;
+    int k0 = 0;
+    for (int k = 1; k < 3; ++k)
+      if (std::abs(u[k]) < std::abs(u[k0])) k0 = k;
+    e1 = Eigen::Vector3d::Unit(k0).cross(u).normalized();
+    e2 = u.cross(e1);
+  }
   Eigen::Vector3d radial(const Eigen::Vector3d& x) const {
     const Eigen::Vector3d q = x - b;
     return q - q.dot(u) * u;
   }
+  // The projection on Π, from the axis, in the frame (e1, e2): affine, so it commutes with
+  // the barycentric combinations that define new vertices.
+  Eigen::Vector2d project(const Eigen::Vector3d& x) const {
+    const Eigen::Vector3d q = x - b;
+    return {q.dot(e1), q.dot(e2)};
+  }
 };
 
 // The roots α in [0, 1] of |μ + α(ν − μ)|² = r² (eqs 18–20 with α from μ), ascending.
-int edge_roots(const Eigen::Vector3d& mu, const Eigen::Vector3d& nu, double r2, double out[2]) {
-  const Eigen::Vector3d d = nu - mu;
+int edge_roots(const Eigen::Vector2d& mu, const Eigen::Vector2d& nu, double r2, double out[2]) {
+  const Eigen::Vector2d d = nu - mu;
   const double k = d.squaredNorm(), l = 2 * mu.dot(d), n = mu.squaredNorm() - r2;
   if (!(k > 0)) return 0;  // the edge is parallel to the axis: its projection is a point
   const double disc = l * l - 4 * k * n;
@@ -39,6 +53,62 @@ int edge_roots(const Eigen::Vector3d& mu, const Eigen::Vector3d& nu, double r2, 
   if (r1 >= 0 && r1 <= 1 && r1 != r0) out[count++] = r1;
   return count;
 }
+
+// Open addressing (linear probing, Fibonacci hashing) from a 64-bit key to an int32, for the
+// drill's scratch tables of a few dozen to a few thousand entries. No erase.
+class FlatMap {
+ public:
+  static constexpr std::int32_t kNone = -1;
+  explicit FlatMap(std::size_t expected = 32) {
+    std::size_t cap = 16;
+    while (cap < 2 * expected) cap *= 2;
+    rehash(cap);
+  }
+  std::int32_t find(std::uint64_t key) const {
+    for (std::size_t s = home(key);; s = (s + 1) & mask_) {
+      if (slots_[s].key == key) return slots_[s].value;
+      if (slots_[s].key == kEmpty) return kNone;
+    }
+  }
+  /// Inserts key → value, or overwrites the value when `overwrite`; returns the stored value.
+  std::int32_t insert(std::uint64_t key, std::int32_t value, bool overwrite = false) {
+    if (2 * (size_ + 1) > slots_.size()) rehash(2 * slots_.size());
+    std::size_t s = home(key);
+    for (; slots_[s].key != kEmpty; s = (s + 1) & mask_)
+      if (slots_[s].key == key) {
+        if (overwrite) slots_[s].value = value;
+        return slots_[s].value;
+      }
+    slots_[s] = {key, value};
+    ++size_;
+    return value;
+  }
+  static std::uint64_t pair(std::int32_t u, std::int32_t v) {
+    return (std::uint64_t(std::uint32_t(u)) << 32) | std::uint32_t(v);
+  }
+
+ private:
+  static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
+  struct Slot {
+    std::uint64_t key;
+    std::int32_t value;
+  };
+  std::size_t home(std::uint64_t key) const {
+    return std::size_t((key * 0x9E3779B97F4A7C15ull) >> shift_);
+  }
+  void rehash(std::size_t capacity) {
+    std::vector<Slot> old = std::move(slots_);
+    slots_.assign(capacity, Slot{kEmpty, kNone});
+    mask_ = capacity - 1;
+    shift_ = 64 - std::countr_zero(capacity);
+    size_ = 0;
+    for (const Slot& o : old)
+      if (o.key != kEmpty) insert(o.key, o.value);
+  }
+  std::vector<Slot> slots_;
+  std::size_t mask_ = 0, size_ = 0;
+  int shift_ = 64;
+};
 
 }  // namespace
 
@@ -62,13 +132,12 @@ void check_input(const SkinnedMesh& mesh, const Adjacency& adjacency, const Dril
 
 // A hole's patch and what the tube needs of it.
 struct Patch {
-  std::vector<std::int32_t> faces;
-  double t = 2;                                // where the axis pierces it, from B (0) to A (1)
-  bool entering = false;                       // its pierced face's normal points against B→A
-  std::size_t added_begin = 0, added_end = 0;  // its faces in the hole change's added_faces
-  std::vector<std::int32_t> removed;           // its removed faces
-  std::vector<std::int32_t> rim;               // its rim loop, in boundary order; empty: none
+  double t = 2;                   // where the axis pierces it, from B (0) to A (1)
+  bool entering = false;          // its pierced face's normal points against B→A
+  std::vector<std::int32_t> rim;  // its rim loop (mesh indices), in boundary order; empty: none
   bool cut = false;
+  int crossings = 0;  // rim crossings of its edges (refinement's count)
+  double limit = 0;   // the longest edge allowed for a face the rim crosses
 };
 
 DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index,
@@ -106,60 +175,296 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex& index, con
 
 namespace {
 
-// The boundary loop the hole change `ch` (not yet applied) leaves around `hole`, as rim
-// vertices in boundary order (the surface on the left), or empty when the boundary there is
-// not one simple loop of rim vertices (new vertices on the cylinder, or snapped ones).
-template <class SideOf>
-std::vector<std::int32_t> rim_loop(const SkinnedMesh& mesh, const Adjacency& adjacency,
-                                   const TopologyChange& ch, const Patch& hole,
-                                   const SideOf& side_of) {
-  auto removed = [&](std::int32_t f) {
-    return std::binary_search(ch.removed_faces.begin(), ch.removed_faces.end(), f);
-  };
-  EdgeMap added;
-  for (std::size_t k = hole.added_begin; k < hole.added_end; ++k)
-    for (int e = 0; e < 3; ++e)
-      added.insert(ch.added_faces[k][e], ch.added_faces[k][(e + 1) % 3], 1);
-  EdgeMap next;  // (0, u) → v for the boundary half-edge u → v
-  std::size_t count = 0;
-  std::int32_t start = -1;
-  bool simple = true;
-  auto boundary = [&](std::int32_t u, std::int32_t v) {
-    simple = simple && next.insert(0, u, v);
-    ++count;
-    start = u;
-  };
-  // Half-edges of the clipped faces with no surviving twin, and half-edges of surviving faces
-  // whose twin was removed without replacement.
-  for (std::size_t k = hole.added_begin; k < hole.added_end; ++k)
-    for (int e = 0; e < 3; ++e) {
-      const std::int32_t u = ch.added_faces[k][e], v = ch.added_faces[k][(e + 1) % 3];
-      if (added.find(v, u) >= 0) continue;
-      const std::int32_t h = adjacency.find(v, u);
-      if (h >= 0 && !removed(h / 3)) continue;
-      boundary(u, v);
+// An affine combination Σ c_i x_{p_i} of at most three ORIGINAL vertices: every point the drill
+// makes lies in one original face, so its rest position, weights (§4.3), UVs and normal follow
+// from the original corners in one step, however many bisections made it.
+struct Combination {
+  std::array<std::int32_t, 3> parent{-1, -1, -1};
+  std::array<double, 3> coefficient{0, 0, 0};
+  int count = 0;
+  void add(std::int32_t p, double c) {
+    for (int i = 0; i < count; ++i)
+      if (parent[i] == p) {
+        coefficient[i] += c;
+        return;
+      }
+    // Both ends of an edge lie in the closure of one original face: at most its 3 corners.
+    if (count == 3) throw std::logic_error("drill: a new vertex outside its original face");
+    parent[count] = p;
+    coefficient[count++] = c;
+  }
+  // (1 − t) a + t b
+  static Combination between(const Combination& a, const Combination& b, double t) {
+    Combination m;
+    for (int i = 0; i < a.count; ++i) m.add(a.parent[i], (1 - t) * a.coefficient[i]);
+    for (int i = 0; i < b.count; ++i) m.add(b.parent[i], t * b.coefficient[i]);
+    return m;
+  }
+  NewVertex new_vertex() const {
+    // Renormalized: the sum drifts from 1 by rounding only.
+    if (count == 2) {
+      const double t = coefficient[1] / (coefficient[0] + coefficient[1]);
+      return NewVertex::on_edge(parent[0], parent[1], t);
     }
-  for (auto g : hole.removed) {
-    const Face& t = mesh.faces[static_cast<std::size_t>(g)];
-    for (int e = 0; e < 3; ++e) {
-      const std::int32_t a = t[e], b = t[(e + 1) % 3];
-      const std::int32_t h = adjacency.find(b, a);
-      if (h < 0 || removed(h / 3) || added.find(a, b) >= 0) continue;
-      boundary(b, a);
+    const double s = coefficient[0] + coefficient[1] + coefficient[2];
+    return NewVertex::in_face(parent[0], parent[1], parent[2], coefficient[0] / s,
+                              coefficient[1] / s, coefficient[2] / s);
+  }
+};
+
+// The part of the mesh the drill works on, copied out so that refinement, clipping and the
+// rim are computed on a few dozen to a few thousand faces, and applied as ONE change.
+//
+// Faces are loaded from the mesh on demand (the patch walk, then whatever the longest-edge
+// bisection reaches); each local face lies in one original face (its origin). Half-edge
+// 3 f + k of local face f runs from v[k] to v[k + 1]; its twin is a local half-edge (≥ 0),
+// kBoundary, or an unloaded mesh half-edge h encoded as −2 − h (the `pending` map then leads
+// from h back to this side, so that loading h's face links the two).
+class Region {
+ public:
+  static constexpr std::int32_t kBoundary = -1;
+  struct Vertex {
+    Eigen::Vector3d x;  // current position
+    Eigen::Vector2d q;  // projection on Π, from the axis
+    Combination def;
+    std::int32_t index = -1;  // in the mesh: original vertices from the start, new ones on emit
+    int side = 1;             // +1 outside, −1 inside, 0 on the cylinder (snapped)
+    bool rim = false;         // a new vertex on the cylinder
+  };
+  struct LocalFace {
+    std::array<std::int32_t, 3> v;
+    std::array<std::int32_t, 3> twin;
+    std::int32_t origin;  // index into origins
+    std::int32_t patch;   // the hole it belongs to
+    std::int32_t depth;   // bisections since its original face
+  };
+  struct Origin {
+    std::int32_t face;  // in the mesh
+    bool modified = false;
+    bool seed = false;  // pierced by the axis
+  };
+
+  Region(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis& axis)
+      : mesh_(mesh), adjacency_(adjacency), axis_(axis) {}
+
+  std::vector<Vertex> verts;
+  std::vector<LocalFace> faces;
+  std::vector<Origin> origins;
+
+  bool inside(const Eigen::Vector2d& q) const { return q.squaredNorm() < axis_.r2; }
+
+  std::int32_t vertex(std::int32_t g) {
+    const std::int32_t known = vertex_of_.find(std::uint64_t(g));
+    if (known >= 0) return known;
+    const Eigen::Vector3d x = mesh_.current.col(g);
+    // Only the positions the drill reads are checked (a whole-mesh check is O(V)).
+    if (!x.allFinite()) throw std::invalid_argument("drill: non-finite positions");
+    Vertex v;
+    v.x = x;
+    v.q = axis_.project(x);
+    v.def.add(g, 1);
+    v.index = g;
+    v.side = inside(v.q) ? -1 : 1;
+    const auto id = static_cast<std::int32_t>(verts.size());
+    verts.push_back(v);
+    vertex_of_.insert(std::uint64_t(g), id);
+    return id;
+  }
+
+  // The new vertex (1 − t) a + t b.
+  std::int32_t between(std::int32_t a, std::int32_t b, double t) {
+    Vertex v;
+    const Vertex &va = verts[std::size_t(a)], &vb = verts[std::size_t(b)];
+    v.x = (1 - t) * va.x + t * vb.x;
+    v.q = (1 - t) * va.q + t * vb.q;
+    v.def = Combination::between(va.def, vb.def, t);
+    v.side = inside(v.q) ? -1 : 1;
+    verts.push_back(v);
+    return static_cast<std::int32_t>(verts.size() - 1);
+  }
+
+  std::int32_t loaded(std::int32_t g) const { return face_of_.find(std::uint64_t(g)); }
+
+  std::int32_t load_face(std::int32_t g, std::int32_t patch) {
+    const auto lf = static_cast<std::int32_t>(faces.size());
+    face_of_.insert(std::uint64_t(g), lf);
+    const Face& t = mesh_.faces[std::size_t(g)];
+    LocalFace f{{vertex(t[0]), vertex(t[1]), vertex(t[2])},
+                {kBoundary, kBoundary, kBoundary},
+                static_cast<std::int32_t>(origins.size()),
+                patch,
+                0};
+    origins.push_back({g});
+    faces.push_back(f);
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t h = 3 * g + k, here = 3 * lf + k;
+      const std::int32_t other = pending_.find(std::uint64_t(h));
+      if (other >= 0) {
+        link(here, other);
+      } else if (const std::int32_t gh = adjacency_.twin(h); gh >= 0) {
+        set_twin(here, -2 - gh);
+      }
+    }
+    return lf;
+  }
+
+  // An edge comes within r of the axis: an end inside, or its projection's closest point.
+  bool edge_near(std::int32_t a, std::int32_t b) const {
+    const Eigen::Vector2d &mu = verts[std::size_t(a)].q, &nu = verts[std::size_t(b)].q;
+    if (inside(mu) || inside(nu)) return true;
+    double roots[2];
+    return edge_roots(mu, nu, axis_.r2, roots) == 2;
+  }
+  bool face_near(std::int32_t g) {
+    const Face& t = mesh_.faces[std::size_t(g)];
+    const std::int32_t a = vertex(t[0]), b = vertex(t[1]), c = vertex(t[2]);
+    return edge_near(a, b) || edge_near(b, c) || edge_near(c, a);
+  }
+
+  // Breadth-first from the pierced face g over faces that come within r of the axis: the patch
+  // of one hole. Faces already loaded (another seed's patch) are skipped.
+  void walk(std::int32_t g, std::int32_t patch) {
+    std::size_t head = faces.size();
+    load_face(g, patch);
+    for (; head < faces.size(); ++head) {
+      const std::int32_t from = origins[std::size_t(faces[head].origin)].face;
+      for (int k = 0; k < 3; ++k) {
+        const std::int32_t n = adjacency_.neighbor(from, k);
+        if (n < 0 || loaded(n) >= 0 || !face_near(n)) continue;
+        load_face(n, patch);
+      }
     }
   }
-  if (!simple || count < 3) return {};
-  std::vector<std::int32_t> loop;
-  std::int32_t v = start;
-  do {
-    if (!(v >= ch.base_vertex_count || side_of(v) == 0)) return {};  // not a rim vertex
-    loop.push_back(v);
-    v = next.find(0, v);
-    if (v < 0) return {};
-  } while (v != start && loop.size() <= count);
-  if (loop.size() != count) return {};  // more than one loop
-  return loop;
-}
+
+  double edge_length2(std::int32_t f, int k) const {
+    const LocalFace& t = faces[std::size_t(f)];
+    return (verts[std::size_t(t.v[k])].x - verts[std::size_t(t.v[(k + 1) % 3])].x).squaredNorm();
+  }
+  // The longest edge of f, ties broken by the vertices: a strict order of the edges, so that
+  // the two faces of an edge agree on whether it is their longest.
+  int longest_edge(std::int32_t f) const {
+    const LocalFace& t = faces[std::size_t(f)];
+    int best = 0;
+    double best_len = edge_length2(f, 0);
+    auto key = [&](int k) {
+      const std::int32_t a = t.v[k], b = t.v[(k + 1) % 3];
+      return std::pair{std::min(a, b), std::max(a, b)};
+    };
+    for (int k = 1; k < 3; ++k) {
+      const double len = edge_length2(f, k);
+      if (len > best_len || (len == best_len && key(k) > key(best))) best = k, best_len = len;
+    }
+    return best;
+  }
+
+  // Splits local face f at the midpoint of its edge k, and the face across it (each 1-to-2).
+  void bisect(std::int32_t f, int k) {
+    const LocalFace F = faces[std::size_t(f)];
+    const std::int32_t a = F.v[k], b = F.v[(k + 1) % 3], c = F.v[(k + 2) % 3];
+    const std::int32_t t_ab = F.twin[k], t_bc = F.twin[(k + 1) % 3], t_ca = F.twin[(k + 2) % 3];
+    const std::int32_t m = between(a, b, 0.5);
+    origins[std::size_t(F.origin)].modified = true;
+    const auto f2 = static_cast<std::int32_t>(faces.size());
+    faces[std::size_t(f)] = {
+        {a, m, c}, {kBoundary, kBoundary, kBoundary}, F.origin, F.patch, F.depth + 1};
+    faces.push_back({{m, b, c}, {kBoundary, kBoundary, kBoundary}, F.origin, F.patch, F.depth + 1});
+    touched.push_back(f), touched.push_back(f2);
+    link(3 * f + 1, 3 * f2 + 2);  // m→c, c→m
+    set_twin(3 * f + 2, t_ca);
+    set_twin(3 * f2 + 1, t_bc);
+    if (t_ab < 0) return;  // a boundary edge (an unloaded twin was loaded by the caller)
+    const std::int32_t g = t_ab / 3, j = t_ab % 3;  // edge j of g runs b → a
+    const LocalFace G = faces[std::size_t(g)];
+    const std::int32_t d = G.v[(j + 2) % 3];
+    const std::int32_t t_ad = G.twin[(j + 1) % 3], t_db = G.twin[(j + 2) % 3];
+    origins[std::size_t(G.origin)].modified = true;
+    const auto g2 = static_cast<std::int32_t>(faces.size());
+    faces[std::size_t(g)] = {
+        {b, m, d}, {kBoundary, kBoundary, kBoundary}, G.origin, G.patch, G.depth + 1};
+    faces.push_back({{m, a, d}, {kBoundary, kBoundary, kBoundary}, G.origin, G.patch, G.depth + 1});
+    touched.push_back(g), touched.push_back(g2);
+    link(3 * g, 3 * f2);          // b→m, m→b
+    link(3 * g + 1, 3 * g2 + 2);  // m→d, d→m
+    set_twin(3 * g + 2, t_db);
+    link(3 * g2, 3 * f);  // m→a, a→m
+    set_twin(3 * g2 + 1, t_ad);
+  }
+
+  // Rivara's longest-edge bisection of f: bisect the terminal edge of f's longest-edge
+  // propagation path (the longest edge of both its faces, or a boundary) until f itself is
+  // split. Neighbours stay conforming, and every triangle made keeps at least half the
+  // smallest angle of the triangle it came from: no slivers.
+  void refine(std::int32_t f) {
+    const std::array<std::int32_t, 3> start = faces[std::size_t(f)].v;
+    for (int guard = 0; faces[std::size_t(f)].v == start && guard < 64; ++guard) {
+      std::int32_t cur = f;
+      int k = longest_edge(cur);
+      for (;;) {
+        std::int32_t tw = faces[std::size_t(cur)].twin[k];
+        if (tw <= -2) {  // the neighbour is not loaded yet
+          load_face((-2 - tw) / 3, faces[std::size_t(cur)].patch);
+          tw = faces[std::size_t(cur)].twin[k];
+        }
+        if (tw < 0) break;
+        const std::int32_t g = tw / 3;
+        const int j = longest_edge(g);
+        if (j == tw % 3) break;  // the terminal edge
+        cur = g, k = j;
+      }
+      bisect(cur, k);
+    }
+  }
+
+  // The projection of face f contains the axis (the disc may lie wholly inside it).
+  bool contains_axis(std::int32_t f) const {
+    const LocalFace& t = faces[std::size_t(f)];
+    double s[3];
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d &p = verts[std::size_t(t.v[k])].q,
+                            &q = verts[std::size_t(t.v[(k + 1) % 3])].q;
+      s[k] = p.x() * q.y() - p.y() * q.x();  // (p × q): the axis' side of edge p→q
+    }
+    return (s[0] >= 0 && s[1] >= 0 && s[2] >= 0 && s[0] + s[1] + s[2] > 0) ||
+           (s[0] <= 0 && s[1] <= 0 && s[2] <= 0 && s[0] + s[1] + s[2] < 0);
+  }
+
+  // The rim (the cylinder's trace) crosses face f: a vertex on each side, an edge entering and
+  // leaving the disc, or the whole disc inside the pierced face.
+  bool crossed(std::int32_t f) const {
+    const LocalFace& t = faces[std::size_t(f)];
+    int in = 0;
+    for (int k = 0; k < 3; ++k) in += inside(verts[std::size_t(t.v[k])].q);
+    if (in == 3) return false;
+    if (in > 0) return true;
+    for (int k = 0; k < 3; ++k) {
+      double roots[2];
+      if (edge_roots(verts[std::size_t(t.v[k])].q, verts[std::size_t(t.v[(k + 1) % 3])].q, axis_.r2,
+                     roots) == 2)
+        return true;
+    }
+    return origins[std::size_t(t.origin)].seed && contains_axis(f);
+  }
+
+  std::int32_t twin(std::int32_t h) const { return faces[std::size_t(h / 3)].twin[h % 3]; }
+
+  std::vector<std::int32_t> touched;  // faces written by bisect() since the caller cleared it
+
+ private:
+  void link(std::int32_t h, std::int32_t t) {
+    faces[std::size_t(h / 3)].twin[h % 3] = t;
+    faces[std::size_t(t / 3)].twin[t % 3] = h;
+  }
+  void set_twin(std::int32_t h, std::int32_t code) {
+    if (code >= 0) return link(h, code);
+    faces[std::size_t(h / 3)].twin[h % 3] = code;
+    if (code <= -2) pending_.insert(std::uint64_t(-2 - code), h, true);
+  }
+
+  const SkinnedMesh& mesh_;
+  const Adjacency& adjacency_;
+  const Axis& axis_;
+  FlatMap vertex_of_{256}, face_of_{128}, pending_{128};
+};
 
 // Joins consecutive holes along the axis, where the drill enters then leaves the surface, with
 // a strip of triangles between their rim loops (see drill.hpp, step 6).
@@ -264,8 +569,7 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
 DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index,
                        const DrillTool& tool, const DrillOptions& options,
                        const std::vector<SegmentHit>& hits) {
-  const double len = (tool.tip - tool.base).norm();
-  Axis axis{tool.base, (tool.tip - tool.base) / len, len, tool.radius * tool.radius};
+  const Axis axis(tool);
   DrillResult result;
   // The index inserts only the faces that survive all the drill's changes.
   struct Batch {
@@ -281,18 +585,7 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     if (index) index->update(mesh, ch);
     result.changes.push_back(std::move(ch));
   };
-  // The axis parameter where it pierces face f, or −1.
-  auto pierced = [&](std::int32_t f) {
-    const Face& t = mesh.faces[static_cast<std::size_t>(f)];
-    double at = -1;
-    std::array<double, 3> bary{};
-    if (!segment_triangle(tool.base, tool.tip, mesh.current.col(t[0]), mesh.current.col(t[1]),
-                          mesh.current.col(t[2]), at, bary))
-      return -1.0;
-    return at;
-  };
   std::vector<std::int32_t> seeds;
-  std::vector<double> seed_t;
   for (const SegmentHit& h : hits) seeds.push_back(h.face);
   std::sort(seeds.begin(), seeds.end());
   seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
@@ -300,244 +593,245 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     result.message = "the drill's axis does not pierce the surface";
     return result;
   }
-  auto inside = [&](std::int32_t v) {
-    return axis.radial(mesh.current.col(v)).squaredNorm() < axis.r2;
-  };
-  // An edge comes within r of the axis: an end inside, or its projection's closest point.
-  auto edge_near = [&](std::int32_t a, std::int32_t b) {
-    const Eigen::Vector3d mu = axis.radial(mesh.current.col(a)),
-                          nu = axis.radial(mesh.current.col(b));
-    if (mu.squaredNorm() < axis.r2 || nu.squaredNorm() < axis.r2) return true;
-    double roots[2];
-    return edge_roots(mu, nu, axis.r2, roots) == 2;
-  };
-  // Breadth-first patches from the seeds; patches[i].faces lists the faces of hole i.
-  std::vector<Patch> patches;
-  auto walk = [&]() {
-    patches.clear();
-    EdgeMap seen;  // (0, face) → its patch (keys (0, x): EdgeMap hashes u poorly)
-    for (auto s : seeds) {
-      if (seen.find(0, s) >= 0) continue;
-      const auto id = static_cast<std::int32_t>(patches.size());
-      std::vector<std::int32_t> patch;
-      std::deque<std::int32_t> queue{s};
-      seen.insert(0, s, id);
-      while (!queue.empty()) {
-        const std::int32_t f = queue.front();
-        queue.pop_front();
-        patch.push_back(f);
-        for (int k = 0; k < 3; ++k) {
-          const std::int32_t g = adjacency.neighbor(f, k);
-          if (g < 0 || seen.find(0, g) >= 0) continue;
-          const Face& t = mesh.faces[static_cast<std::size_t>(g)];
-          bool near = false;
-          for (int e = 0; e < 3 && !near; ++e) near = edge_near(t[e], t[(e + 1) % 3]);
-          if (!near) continue;
-          seen.insert(0, g, id);
-          queue.push_back(g);
-        }
-      }
-      std::sort(patch.begin(), patch.end());
-      Patch hole;
-      hole.faces = std::move(patch);
-      patches.push_back(std::move(hole));
-    }
-    // Where the axis pierces each patch first, and whether it enters the surface there.
-    for (auto s : seeds) {
-      Patch& p = patches[static_cast<std::size_t>(seen.find(0, s))];
-      const double at = pierced(s);
-      if (at < 0 || at >= p.t) continue;
-      p.t = at;
-      const Face& t = mesh.faces[static_cast<std::size_t>(s)];
-      const Eigen::Vector3d n = (mesh.current.col(t[1]) - mesh.current.col(t[0]))
-                                    .cross(mesh.current.col(t[2]) - mesh.current.col(t[0]));
-      p.entering = n.dot(axis.u) < 0;
-    }
-  };
 
-  // Refine until every patch has enough crossings and no edge enters and leaves the disc.
-  for (bool first = true;; first = false) {
-    walk();
-    if (first)  // only the positions the drill reads are checked (a whole-mesh check is O(V))
-      for (const auto& hole : patches)
-        for (auto f : hole.faces)
-          for (auto v : mesh.faces[static_cast<std::size_t>(f)])
-            if (!mesh.current.col(v).allFinite())
-              throw std::invalid_argument("drill: non-finite positions");
-    std::vector<EdgeSplit> splits;
-    for (const auto& hole : patches) {
-      const auto& patch = hole.faces;
-      int crossings = 0;
-      double longest = 0;  // the longest edge of a face the rim crosses
-      std::vector<EdgeSplit> patch_edges;
-      for (auto f : patch) {
-        const Face& t = mesh.faces[static_cast<std::size_t>(f)];
-        for (int k = 0; k < 3; ++k) {
-          const std::int32_t a = t[k], b = t[(k + 1) % 3];
-          const std::int32_t twin = adjacency.find(b, a);
-          // Count each edge once: from the face with the lower half-edge, or on a boundary.
-          const bool counted_here = twin < 0 || 3 * f + k < twin;
-          const Eigen::Vector3d mu = axis.radial(mesh.current.col(a)),
-                                nu = axis.radial(mesh.current.col(b));
-          const bool ia = mu.squaredNorm() < axis.r2, ib = nu.squaredNorm() < axis.r2;
-          if (ia != ib) {
-            crossings += counted_here;
-            for (int e = 0; e < 3; ++e)
-              longest = std::max(
-                  longest, (mesh.current.col(t[e]) - mesh.current.col(t[(e + 1) % 3])).norm());
-          } else if (!ia) {
-            double roots[2];
-            if (edge_roots(mu, nu, axis.r2, roots) == 2) {
-              splits.push_back({a, b, 0.5 * (roots[0] + roots[1])});  // the point nearest the axis
-              crossings += 2 * counted_here;
-            }
-          }
-          patch_edges.push_back({a, b, 0.5});
-        }
-      }
-      // Enough rim points, and chords short enough for the area (≈ 2π²/3n² short for n even
-      // chords): faces on the rim no longer than 1.5 × the circumference / min_rim_points.
-      const double chord = 1.5 * 2 * std::numbers::pi * tool.radius / options.min_rim_points;
-      if (crossings < options.min_rim_points || longest > chord) {
-        if (result.refinements < options.max_refinements)
-          splits.insert(splits.end(), patch_edges.begin(), patch_edges.end());
-        else
-          result.message = "fewer rim points than min_rim_points after max_refinements";
-      }
-    }
-    if (splits.empty()) break;
-    // Beyond the refinement limit only two-root splits continue, for a bounded number of passes.
-    if (result.refinements >= options.max_refinements + 2) break;
-    TopologyChange ch = split_edges(mesh, adjacency, splits);
-    if (ch.empty()) break;
-    // The new seeds: pierced faces among the added ones and the untouched old seeds (adding
-    // at least as many faces as are removed moves no face).
-    std::vector<std::int32_t> candidates = added_face_indices(ch);
-    for (auto s : seeds)
-      if (!std::binary_search(ch.removed_faces.begin(), ch.removed_faces.end(), s))
-        candidates.push_back(s);
-    commit(std::move(ch));
-    ++result.refinements;
-    seeds.clear();
-    for (auto f : candidates)
-      if (pierced(f) >= 0) seeds.push_back(f);
-    std::sort(seeds.begin(), seeds.end());
-    seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  // 1–2. The patches: one breadth-first walk from each pierced face not yet reached.
+  Region region(mesh, adjacency, axis);
+  std::vector<Patch> patches;
+  for (auto s : seeds) {
+    if (region.loaded(s) >= 0) continue;
+    region.walk(s, static_cast<std::int32_t>(patches.size()));
+    patches.emplace_back();
+  }
+  // Where the axis pierces each patch first, and whether it enters the surface there.
+  for (const SegmentHit& h : hits) {
+    const Region::LocalFace& lf = region.faces[std::size_t(region.loaded(h.face))];
+    region.origins[std::size_t(lf.origin)].seed = true;
+    Patch& p = patches[std::size_t(lf.patch)];
+    if (h.t >= p.t) continue;
+    p.t = h.t;
+    const Face& t = mesh.faces[std::size_t(h.face)];
+    const Eigen::Vector3d n = (mesh.current.col(t[1]) - mesh.current.col(t[0]))
+                                  .cross(mesh.current.col(t[2]) - mesh.current.col(t[0]));
+    p.entering = n.dot(axis.u) < 0;
   }
 
-  // Classify the patches' vertices: +1 outside, −1 inside, 0 on the cylinder (snapped).
-  EdgeMap side;  // (0, vertex) → side + 1
-  auto side_of = [&](std::int32_t v) { return side.find(0, v) - 1; };
-  for (const auto& hole : patches)
-    for (auto f : hole.faces)
-      for (auto v : mesh.faces[static_cast<std::size_t>(f)])
-        if (side.find(0, v) < 0) side.insert(0, v, inside(v) ? 0 : 2);
-  const std::int32_t nv0 = mesh.vertex_count();
-  TopologyChange ch;
-  ch.base_vertex_count = nv0;
-  ch.base_face_count = mesh.face_count();
+  // 3–4. Refinement where the rim crosses: a face it crosses longer than the patch's limit is
+  // bisected (longest edge first, neighbours kept conforming), until its faces are short
+  // enough for the area (chords ≤ 1.5 × the circumference / min_rim_points: the inscribed
+  // polygon loses ≈ θ²/6 of πr² for chords of angle θ) and the rim crosses at least
+  // min_rim_points edges, else the limit halves. A face's depth counts its bisections; two
+  // bisections halve a triangle like one 1-to-4 split, so `refinements` reports depth / 2.
+  const int min_rim = std::max(options.min_rim_points, 3);
+  const int max_depth = 2 * std::max(options.max_refinements, 0);
+  for (auto& p : patches) p.limit = 1.5 * 2 * std::numbers::pi * tool.radius / min_rim;
+  std::vector<std::int32_t> work;
+  for (int pass = 0;; ++pass) {
+    work.clear();
+    for (std::size_t f = region.faces.size(); f-- > 0;) work.push_back(std::int32_t(f));
+    while (!work.empty()) {
+      const std::int32_t f = work.back();
+      work.pop_back();
+      const Region::LocalFace& lf = region.faces[std::size_t(f)];
+      const double limit = patches[std::size_t(lf.patch)].limit;
+      if (lf.depth >= max_depth || !region.crossed(f) ||
+          region.edge_length2(f, region.longest_edge(f)) <= limit * limit)
+        continue;
+      region.touched.clear();
+      region.refine(f);
+      work.insert(work.end(), region.touched.rbegin(), region.touched.rend());
+    }
+    // Count the crossings, each edge once (from its lower half-edge, or its only loaded one).
+    for (auto& p : patches) p.crossings = 0;
+    for (std::size_t f = 0; f < region.faces.size(); ++f) {
+      const Region::LocalFace& lf = region.faces[f];
+      for (int k = 0; k < 3; ++k) {
+        const std::int32_t tw = lf.twin[k];
+        if (tw >= 0 && tw < std::int32_t(3 * f) + k) continue;
+        const auto &a = region.verts[std::size_t(lf.v[k])],
+                   &b = region.verts[std::size_t(lf.v[(k + 1) % 3])];
+        patches[std::size_t(lf.patch)].crossings += a.side != b.side;
+      }
+    }
+    bool again = false;
+    for (auto& p : patches)
+      if (p.crossings < min_rim && pass < max_depth) p.limit *= 0.5, again = true;
+    if (!again) break;
+  }
+  int depth = 0;
+  for (const auto& lf : region.faces) depth = std::max(depth, int(lf.depth));
+  result.refinements = (depth + 1) / 2;
+  for (const auto& p : patches)
+    if (p.crossings > 0 && p.crossings < min_rim)
+      result.message = "fewer rim points than min_rim_points after max_refinements";
+
+  // 5. Classify: +1 outside, −1 inside, 0 on the cylinder. A vertex closer to the rim than
+  // snap_fraction of an edge it ends is taken as a rim vertex (no slivers).
   auto crossing_t = [&](std::int32_t a, std::int32_t b) {
     double roots[2];
-    const int n = edge_roots(axis.radial(mesh.current.col(a)), axis.radial(mesh.current.col(b)),
-                             axis.r2, roots);
+    const int n =
+        edge_roots(region.verts[std::size_t(a)].q, region.verts[std::size_t(b)].q, axis.r2, roots);
     return n > 0 ? roots[0] : 0.5;
   };
-  for (const auto& hole : patches)
-    for (auto f : hole.faces) {
-      const Face& t = mesh.faces[static_cast<std::size_t>(f)];
-      for (int k = 0; k < 3; ++k) {
-        const std::int32_t a = std::min(t[k], t[(k + 1) % 3]), b = std::max(t[k], t[(k + 1) % 3]);
-        const int sa = side_of(a), sb = side_of(b);
-        if (sa * sb >= 0) continue;
-        const double tt = crossing_t(a, b);
-        if (tt < options.snap_fraction)
-          side.insert(0, a, 1, true), ++result.snapped_rim_vertices;
-        else if (tt > 1 - options.snap_fraction)
-          side.insert(0, b, 1, true), ++result.snapped_rim_vertices;
-      }
+  for (const auto& lf : region.faces)
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t a = std::min(lf.v[k], lf.v[(k + 1) % 3]),
+                         b = std::max(lf.v[k], lf.v[(k + 1) % 3]);
+      auto &va = region.verts[std::size_t(a)], &vb = region.verts[std::size_t(b)];
+      if (va.side * vb.side >= 0) continue;
+      const double t = crossing_t(a, b);
+      if (t < options.snap_fraction)
+        va.side = 0, ++result.snapped_rim_vertices;
+      else if (t > 1 - options.snap_fraction)
+        vb.side = 0, ++result.snapped_rim_vertices;
     }
-  EdgeMap xmap;
+  // Faces with a vertex inside are removed (2) or, with one outside too, clipped (1).
+  std::vector<std::uint8_t> fate(region.faces.size(), 0);
+  for (std::size_t f = 0; f < region.faces.size(); ++f) {
+    const Region::LocalFace& lf = region.faces[f];
+    bool in = false, out = false;
+    for (auto v : lf.v) {
+      in = in || region.verts[std::size_t(v)].side < 0;
+      out = out || region.verts[std::size_t(v)].side > 0;
+    }
+    if (!in) continue;
+    fate[f] = out ? 1 : 2;
+    region.origins[std::size_t(lf.origin)].modified = true;
+    patches[std::size_t(lf.patch)].cut = true;
+    ++result.removed_area_faces;
+  }
+  FlatMap crossing_vertex(64);
   auto cross_vertex = [&](std::int32_t u, std::int32_t w) {
     const std::int32_t a = std::min(u, w), b = std::max(u, w);
-    std::int32_t id = xmap.find(a, b);
-    if (id >= 0) return id;
-    id = nv0 + static_cast<std::int32_t>(ch.new_vertices.size());
-    ch.new_vertices.push_back(NewVertex::on_edge(a, b, crossing_t(a, b)));
-    xmap.insert(a, b, id);
+    const std::int32_t made = static_cast<std::int32_t>(region.verts.size());
+    const std::int32_t id = crossing_vertex.insert(FlatMap::pair(a, b), made);
+    if (id == made) region.verts[std::size_t(region.between(a, b, crossing_t(a, b)))].rim = true;
     return id;
   };
-  auto area = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
-    return 0.5 * (b - a).cross(c - a).norm();
+  auto area = [&](std::int32_t a, std::int32_t b, std::int32_t c) {
+    const Eigen::Vector3d &pa = region.verts[std::size_t(a)].x,
+                          &pb = region.verts[std::size_t(b)].x,
+                          &pc = region.verts[std::size_t(c)].x;
+    return 0.5 * (pb - pa).cross(pc - pa).norm();
   };
-  auto pos = [&](std::int32_t v) -> Eigen::Vector3d {
-    if (v < nv0) return mesh.current.col(v);
-    const NewVertex& n = ch.new_vertices[static_cast<std::size_t>(v - nv0)];
-    return n.coefficients[0] * mesh.current.col(n.parents[0]) +
-           n.coefficients[1] * mesh.current.col(n.parents[1]);
-  };
-  std::vector<std::int32_t> removed;
-  for (auto& hole : patches) {
-    bool cut_any = false;
-    hole.added_begin = ch.added_faces.size();
-    for (auto f : hole.faces) {
-      const Face& t = mesh.faces[static_cast<std::size_t>(f)];
-      const int s[3] = {side_of(t[0]), side_of(t[1]), side_of(t[2])};
-      const bool has_in = s[0] < 0 || s[1] < 0 || s[2] < 0;
-      if (!has_in) continue;
-      const bool has_out = s[0] > 0 || s[1] > 0 || s[2] > 0;
-      removed.push_back(f);
-      hole.removed.push_back(f);
-      cut_any = true;
-      const double a0 = area(pos(t[0]), pos(t[1]), pos(t[2]));
-      double kept = 0;
-      auto keep = [&](std::int32_t a, std::int32_t b, std::int32_t c) {
-        ch.added_faces.push_back({a, b, c});
-        kept += area(pos(a), pos(b), pos(c));
-      };
-      if (has_out) {
-        int zero = -1;
-        for (int k = 0; k < 3; ++k)
-          if (s[k] == 0) zero = k;
-        if (zero >= 0) {
-          const std::int32_t v0 = t[zero], v1 = t[(zero + 1) % 3], v2 = t[(zero + 2) % 3];
-          const std::int32_t x = cross_vertex(v1, v2);
-          if (s[(zero + 1) % 3] > 0)
-            keep(v0, v1, x);
-          else
-            keep(v0, x, v2);
-        } else {
-          int lone = 0;
-          for (int k = 0; k < 3; ++k)
-            if (s[(k + 1) % 3] == s[(k + 2) % 3]) lone = k;
-          const std::int32_t v0 = t[lone], v1 = t[(lone + 1) % 3], v2 = t[(lone + 2) % 3];
-          const std::int32_t x01 = cross_vertex(v0, v1), x20 = cross_vertex(v2, v0);
-          if (s[lone] > 0) {
-            keep(v0, x01, x20);
-          } else if ((pos(x01) - pos(v2)).squaredNorm() <= (pos(v1) - pos(x20)).squaredNorm()) {
-            keep(x01, v1, v2), keep(x01, v2, x20);
-          } else {
-            keep(x01, v1, x20), keep(v1, v2, x20);
-          }
-        }
-      }
-      result.removed_area += a0 - kept;
+  // The faces that replace the modified original faces (local vertices), and the hole's
+  // boundary half-edges (the surface on their left) per patch, for the tube.
+  std::vector<Face> added;
+  std::vector<std::array<std::int32_t, 3>> hole_edges;  // (patch, from, to)
+  for (std::size_t f = 0; f < region.faces.size(); ++f) {
+    const Region::LocalFace& lf = region.faces[f];
+    const auto& t = lf.v;
+    if (fate[f] == 0) {
+      if (region.origins[std::size_t(lf.origin)].modified) added.push_back(t);
+      continue;
     }
-    hole.added_end = ch.added_faces.size();
-    hole.cut = cut_any;
-    result.holes += cut_any;
+    const double a0 = area(t[0], t[1], t[2]);
+    if (fate[f] == 2) {
+      result.removed_area += a0;
+      // An edge shared with a kept face (both ends on the rim) borders the hole.
+      for (int k = 0; k < 3; ++k) {
+        const std::int32_t tw = lf.twin[k];
+        if (tw == Region::kBoundary || (tw >= 0 && fate[std::size_t(tw / 3)] != 0)) continue;
+        hole_edges.push_back({lf.patch, t[(k + 1) % 3], t[k]});
+      }
+      continue;
+    }
+    const int s[3] = {region.verts[std::size_t(t[0])].side, region.verts[std::size_t(t[1])].side,
+                      region.verts[std::size_t(t[2])].side};
+    double kept = 0;
+    auto keep = [&](std::int32_t a, std::int32_t b, std::int32_t c) {
+      added.push_back({a, b, c});
+      kept += area(a, b, c);
+    };
+    auto cut = [&](std::int32_t from, std::int32_t to) {
+      hole_edges.push_back({lf.patch, from, to});
+    };
+    int zero = -1;
+    for (int k = 0; k < 3; ++k)
+      if (s[k] == 0) zero = k;
+    if (zero >= 0) {
+      const std::int32_t v0 = t[zero], v1 = t[(zero + 1) % 3], v2 = t[(zero + 2) % 3];
+      const std::int32_t x = cross_vertex(v1, v2);
+      if (s[(zero + 1) % 3] > 0)
+        keep(v0, v1, x), cut(x, v0);
+      else
+        keep(v0, x, v2), cut(v0, x);
+    } else {
+      int lone = 0;
+      for (int k = 0; k < 3; ++k)
+        if (s[(k + 1) % 3] == s[(k + 2) % 3]) lone = k;
+      const std::int32_t v0 = t[lone], v1 = t[(lone + 1) % 3], v2 = t[(lone + 2) % 3];
+      const std::int32_t x01 = cross_vertex(v0, v1), x20 = cross_vertex(v2, v0);
+      if (s[lone] > 0) {
+        keep(v0, x01, x20), cut(x01, x20);
+      } else {
+        const auto& X = region.verts;
+        if ((X[std::size_t(x01)].x - X[std::size_t(v2)].x).squaredNorm() <=
+            (X[std::size_t(v1)].x - X[std::size_t(x20)].x).squaredNorm())
+          keep(x01, v1, v2), keep(x01, v2, x20);
+        else
+          keep(x01, v1, x20), keep(v1, v2, x20);
+        cut(x20, x01);
+      }
+    }
+    result.removed_area += a0 - kept;
   }
-  result.removed_area_faces = static_cast<std::int32_t>(removed.size());
-  result.rim_vertices = static_cast<std::int32_t>(ch.new_vertices.size());
-  std::sort(removed.begin(), removed.end());
-  ch.removed_faces = std::move(removed);
+  for (const auto& p : patches) result.holes += p.cut;
   if (result.holes == 0) {
     result.message = "the drill pierces the surface but removes nothing";
     return result;
   }
-  if (options.tube) {
-    for (auto& hole : patches)
-      if (hole.cut) hole.rim = rim_loop(mesh, adjacency, ch, hole, side_of);
-  }
+
+  // The change: new vertices that the added faces use (refinement's first, then the rim's),
+  // each one combination of original vertices; the modified original faces out, the pieces in.
+  TopologyChange ch;
+  ch.base_vertex_count = mesh.vertex_count();
+  ch.base_face_count = mesh.face_count();
+  for (const Face& t : added)
+    for (auto v : t)
+      if (region.verts[std::size_t(v)].index < 0) region.verts[std::size_t(v)].index = -2;
+  for (auto& v : region.verts)
+    if (v.index == -2) {
+      v.index = ch.base_vertex_count + static_cast<std::int32_t>(ch.new_vertices.size());
+      ch.new_vertices.push_back(v.def.new_vertex());
+      result.rim_vertices += v.rim;
+    }
+  for (const auto& o : region.origins)
+    if (o.modified) ch.removed_faces.push_back(o.face);
+  std::sort(ch.removed_faces.begin(), ch.removed_faces.end());
+  ch.added_faces.reserve(added.size());
+  for (const Face& t : added)
+    ch.added_faces.push_back({region.verts[std::size_t(t[0])].index,
+                              region.verts[std::size_t(t[1])].index,
+                              region.verts[std::size_t(t[2])].index});
+
+  // The rim loops, for the tube: per patch, the hole's boundary half-edges chained into one
+  // loop of rim vertices (empty when they are not one simple loop).
+  if (options.tube)
+    for (std::size_t p = 0; p < patches.size(); ++p) {
+      if (!patches[p].cut) continue;
+      FlatMap next(32);
+      std::size_t count = 0;
+      std::int32_t start = -1;
+      bool simple = true;
+      for (const auto& [patch, from, to] : hole_edges) {
+        if (patch != std::int32_t(p)) continue;
+        simple = simple && next.insert(std::uint64_t(from), to) == to;
+        ++count, start = from;
+      }
+      std::vector<std::int32_t> loop;
+      for (std::int32_t v = start; simple && count >= 3;) {
+        const auto& x = region.verts[std::size_t(v)];
+        if (!(x.rim || x.side == 0)) break;
+        loop.push_back(x.index);
+        v = next.find(std::uint64_t(v));
+        if (v < 0 || loop.size() > count) break;
+        if (v == start) {
+          if (loop.size() == count) patches[p].rim = std::move(loop);
+          break;
+        }
+      }
+    }
+
   commit(std::move(ch));
   if (options.tube) join_holes(mesh, adjacency, axis, patches, result, commit);
   return result;

@@ -7,15 +7,23 @@
 //      axis (a vertex inside, or an edge whose projection on the plane Π through B
 //      perpendicular to the axis passes inside the disc) marks the affected patch; separate
 //      patches are separate holes (a closed mesh pierced through both walls gets both);
-//   3. each edge of the patch is intersected with the cylinder by the quadratic of eqs 18–20
-//      on its projection on Π (exact: the projection is affine); an edge that enters and leaves
-//      the disc (two roots) is first split at its point closest to the axis, a tangent edge
-//      (double root) does not cross;
-//   4. when a patch yields fewer than min_rim_points crossings, its edges are split (1-to-4
-//      with conforming 1-to-2/1-to-3 neighbours) and the drill is run again;
+//   3. the patch is copied out (with whatever neighbours step 4 reaches) and each of its edges
+//      is intersected with the cylinder by the quadratic of eqs 18–20 on its projection on Π
+//      (exact: the projection is affine); a tangent edge (double root) does not cross;
+//   4. refinement, only where the rim crosses: a face the rim crosses (a vertex on each side,
+//      an edge entering and leaving the disc, or the whole disc inside a pierced face) whose
+//      longest edge exceeds 1.5 × the circumference / min_rim_points is bisected (Rivara's
+//      longest-edge bisection: neighbours stay conforming, angles stay at least half the
+//      original's), and the limit halves while a patch has fewer than min_rim_points crossings.
+//      An edge that enters and leaves the disc between two outside vertices is then shorter
+//      than the limit and is left whole (the area it cuts off is below the inscribed polygon's
+//      own shortfall). Faces wholly inside or outside are not refined;
 //   5. the inside is removed and the rim re-triangulated (split triangles stay triangles).
 // Vertices closer to the cylinder than snap_fraction of an edge are taken as rim vertices (not
 // moved), so there are no slivers; the computed rim points lie on the cylinder to rounding.
+// Refinement and hole are ONE TopologyChange: every new vertex is a combination of the corners
+// of the original face (or edge) it lies in (NewVertex::in_face / on_edge), so rest positions,
+// weights, UVs and normals follow in one step; refinement vertices come first, the rim's last.
 //
 //   6. optionally (DrillOptions::tube), holes made in two walls of a closed surface, one where
 //      the drill enters and the next along the axis where it leaves, are joined by a tube wall:
@@ -51,21 +59,22 @@ struct DrillTool {
 
 struct DrillOptions {
   int min_rim_points = 24;  // the paper uses 6; 24 keeps the hole's area within 2 % of πr²
-  int max_refinements = 6;
+  int max_refinements = 6;  // at most 2 × this many bisections of an original face
   double snap_fraction = 0.01;
   bool tube = false;  // join entry and exit holes of a closed surface with a tube wall
   FaceSearch search = FaceSearch::Index;
 };
 
 struct DrillResult {
-  std::vector<TopologyChange> changes;  // applied in order: refinements, the holes, the tube
+  std::vector<TopologyChange> changes;  // applied in order: the holes (with their refinement),
+                                        // then one per tube
   std::int32_t holes = 0;
   std::int32_t rim_vertices = 0;          // new vertices on the cylinder
   std::int32_t snapped_rim_vertices = 0;  // existing vertices taken as rim vertices
   std::int32_t removed_area_faces = 0;    // faces removed or clipped
   double removed_area = 0;
-  int refinements = 0;
-  std::int32_t tubes = 0;       // hole pairs joined by a tube wall
+  int refinements = 0;     // refinement rounds: bisection depth / 2 (two bisections ≈ one 1-to-4)
+  std::int32_t tubes = 0;  // hole pairs joined by a tube wall
   std::int32_t tube_faces = 0;  // faces of the tube walls
   std::string message;
 };

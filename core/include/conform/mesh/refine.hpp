@@ -1,7 +1,7 @@
 // Edge splitting without T-junctions: every face that has one, two or three of the given
 // edges split is re-triangulated (1-to-2, 1-to-3 along the shorter diagonal, or 1-to-4), so
-// that neighbours stay conforming. Used by the drill's refinement (its "split the affected
-// faces 1-to-4 and drill again") and for two-root edges.
+// that neighbours stay conforming. (The drill refines its own copy of the patch by longest-edge
+// bisection and emits one change; see drill.hpp.)
 #pragma once
 
 #include <cstdint>
