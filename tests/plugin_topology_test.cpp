@@ -5,12 +5,14 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
 
 #include "conform/bullet/convert.hpp"
 #include "conform/bullet/plugin.hpp"
 #include "conform/mesh/analysis.hpp"
+#include "conform/mesh/primitives.hpp"
 #include "conform/mesh/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 #include "plugin_world.hpp"
@@ -249,6 +251,8 @@ TEST(PluginTopology, DrillDetachesTheHolesInsideKeepingMassAndMomentum) {
   expect_conserved(body, before, result.changes, "drill");
   expect_mirrors_mesh(body, "drill");
   EXPECT_EQ(body.piece_count(), 1);
+  // Proven whole around the two holes, not by searching around the arm from one to the other.
+  EXPECT_LT(body.last_apply().searched_vertices, body.vertex_count() / 4);
   EXPECT_GT(body.detached_count(), 0);
   EXPECT_EQ(body.last_apply().detached_nodes, body.detached_count());
   int nodes = 0;
@@ -313,6 +317,71 @@ TEST(PluginTopology, EditsKeepBendingLinksAcrossEdgesOfTwoFacesOnly) {
   a.w.step(30);
   for (std::int32_t v = 0; v < body.vertex_count(); ++v)
     ASSERT_TRUE(body.position(v).allFinite() && body.velocity(v).allFinite());
+}
+
+// A change that only removes the faces whose rest centroid satisfies `remove`.
+template <class Predicate>
+mesh::TopologyChange remove_faces_where(const mesh::SkinnedMesh& m, Predicate remove) {
+  mesh::TopologyChange change;
+  change.base_vertex_count = m.vertex_count();
+  change.base_face_count = m.face_count();
+  for (std::int32_t f = 0; f < m.face_count(); ++f) {
+    const auto& t = m.faces[std::size_t(f)];
+    const Eigen::Vector3d c = (m.rest.col(t[0]) + m.rest.col(t[1]) + m.rest.col(t[2])) / 3;
+    if (remove(c)) change.removed_faces.push_back(f);
+  }
+  return change;
+}
+
+// The split search proves a body whole from the changed region alone when it can (two holes
+// far apart: no growing until the searches from both meet), and still finds every split (a
+// ring cut out around a disk, a strip across the sheet), whichever way it ends.
+TEST(PluginTopology, SplitSearchStaysLocalForHolesAndFindsEverySplit) {
+  SoftWorld w;
+  bullet::Plugin plugin(w.world);
+  mesh::SkinnedMesh sheet = mesh::make_sheet(40, 40, 1.0, 1.0);
+  sheet.bones.setZero();
+  sheet.weights.setZero();
+  sheet.weights.row(0).setOnes();
+  skin::Skeleton s;
+  s.joints.push_back({"root", -1, skin::Versor::identity()});
+  s.bones.push_back({"root", 0, skin::Versor::identity()});
+  auto& body = plugin.add_skinned_body(sheet, s, {.pretension = 0.1, .kinematic_weight = 2});
+  w.step(3);
+  auto near = [](double x, double y, double r) {
+    return [=](const Eigen::Vector3d& c) { return std::hypot(c.x() - x, c.y() - y) < r; };
+  };
+  // Two holes: one piece, found without searching the sheet.
+  body.sync_mesh();
+  const auto a = near(-0.3, 0, 0.06), b = near(0.3, 0, 0.06);
+  body.apply(remove_faces_where(body.mesh(), [&](auto& c) { return a(c) || b(c); }));
+  expect_mirrors_mesh(body, "two holes");
+  EXPECT_EQ(body.piece_count(), 1);
+  EXPECT_EQ(body.last_apply().moved_nodes, 0);
+  EXPECT_LT(body.last_apply().searched_vertices, body.vertex_count() / 8);
+  // A ring around a disk: the disk is a piece of its own, though every removed face is in one
+  // cluster with vertices on both of its sides.
+  w.step();
+  body.sync_mesh();
+  body.apply(remove_faces_where(body.mesh(), [](const Eigen::Vector3d& c) {
+    const double r = std::hypot(c.x(), c.y());
+    return r > 0.1 && r < 0.14;
+  }));
+  expect_mirrors_mesh(body, "ring");
+  EXPECT_EQ(body.piece_count(), 2);
+  EXPECT_GT(body.last_apply().moved_nodes, 0);
+  // A hole in the disk and a strip across the sheet in one change: three pieces.
+  w.step();
+  body.sync_mesh();
+  const auto in_disk = near(0.02, 0, 0.03);
+  body.apply(remove_faces_where(body.mesh(), [&](const Eigen::Vector3d& c) {
+    return in_disk(c) || std::abs(c.y() - 0.3) < 0.02;
+  }));
+  expect_mirrors_mesh(body, "strip and hole");
+  EXPECT_EQ(body.piece_count(), 3);
+  w.step(3);
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v) ASSERT_TRUE(body.position(v).allFinite());
+  EXPECT_EQ(conform::test::bullet_internals_problem(body), "");
 }
 
 TEST(PluginTopology, ApplyRejectsAChangeForAnotherMesh) {

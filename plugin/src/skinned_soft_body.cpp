@@ -246,7 +246,8 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
   const auto n = static_cast<std::size_t>(m.vertex_count());
   // Room for edits to grow the per-vertex and per-face tables in place (a reallocation would
   // copy the whole table during an edit).
-  for (auto* table : {&piece_of_, &node_of_, &detached_slot_, &search_label_, &move_slot_})
+  for (auto* table :
+       {&piece_of_, &node_of_, &detached_slot_, &search_label_, &move_slot_, &seed_slot_})
     table->reserve(2 * n);
   for (auto* table : {&area_mark_, &seed_mark_, &pinned_, &kinematic_}) table->reserve(2 * n);
   mass_.reserve(2 * n);
@@ -327,6 +328,7 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
     if (piece_of_[static_cast<std::size_t>(v)] >= 0) update_node_area(v);
   area_mark_.assign(n, 0);
   seed_mark_.assign(n, 0);
+  seed_slot_.assign(n, -1);
   clear_kept();
   bend_dirty_.clear();
   stats_ = {};
@@ -833,17 +835,35 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   // an edge that comes back in the same change keeps its rest length).
   std::vector<std::int32_t> seeds;  // vertices around the change (their pieces may split)
   seed_mark_.resize(total, 0);
+  seed_slot_.resize(total, -1);
   auto seed = [&](std::int32_t v) {
-    auto& mark = seed_mark_[static_cast<std::size_t>(v)];
-    if (!mark) mark = 1, seeds.push_back(v);
+    auto& slot = seed_slot_[static_cast<std::size_t>(v)];
+    if (slot < 0) slot = std::int32_t(seeds.size()), seeds.push_back(v);
+  };
+  // Clusters of removed faces (sharing vertices), over the seeds they make: a union-find.
+  std::vector<std::int32_t> cluster;
+  auto cluster_root = [&](std::int32_t i) {
+    while (cluster[static_cast<std::size_t>(i)] != i)
+      i = cluster[static_cast<std::size_t>(i)] =
+          cluster[static_cast<std::size_t>(cluster[static_cast<std::size_t>(i)])];
+    return i;
   };
   std::vector<std::pair<std::int32_t, std::int32_t>> dropped;
   for (const auto f : change.removed_faces) {
     const auto tri = faces_[static_cast<std::size_t>(f)];
     remove_face_from_bullet(f);
+    std::int32_t first = -1;
     for (int k = 0; k < 3; ++k) {
       erase_value(vertex_faces_[static_cast<std::size_t>(tri[k])], f);
       seed(tri[k]);
+      cluster.resize(seeds.size(), -1);
+      const std::int32_t slot = seed_slot_[static_cast<std::size_t>(tri[k])];
+      if (cluster[static_cast<std::size_t>(slot)] < 0)
+        cluster[static_cast<std::size_t>(slot)] = slot;
+      if (first < 0)
+        first = cluster_root(slot);
+      else
+        cluster[static_cast<std::size_t>(cluster_root(slot))] = first;
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
       const std::int32_t c = edge_faces_.find(a, b) - 1;
       if (c > 0) {
@@ -910,7 +930,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   stats_.added_faces += std::int32_t(pending.size());
   stats_.new_nodes += nnew;
   for (std::int32_t i = 0; i < nnew; ++i) seed(v0 + i);
-  for (const auto v : seeds) seed_mark_[static_cast<std::size_t>(v)] = 0;
+  for (const auto v : seeds) seed_slot_[static_cast<std::size_t>(v)] = -1;
   sec.faces += seconds_since(clock);
 
   // 4. Connected pieces around the change. A piece can only split where faces changed, so one
@@ -946,7 +966,62 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   auto growing = std::int32_t(searches.size());
   std::int32_t open_root = -1, open_piece = -1;
   bool to_the_end = false;
+  // A shorter proof that nothing split, for changes inside one body (say a drill through both
+  // walls of the arm, whose two holes' searches would only meet by growing around it): the body
+  // was connected, and an old path can only have used removed faces within one cluster of
+  // them (removed faces sharing vertices), entering and leaving at vertices of that cluster
+  // that keep faces. So once each cluster's surviving vertices are in one group, every old
+  // vertex that keeps faces is still connected to all others; groups that hold one are the
+  // body, and a group of new vertices only is a piece of its own once exhausted (until then
+  // the proof waits).
+  std::vector<std::uint8_t> has_old(searches.size(), 0);
+  std::int32_t only_piece = -1;
+  bool one_body = true;
+  for (std::size_t s = 0; s < searches.size(); ++s) {
+    const std::int32_t v = searches[s].queue[0];
+    if (v >= v0) continue;
+    has_old[s] = 1;
+    const std::int32_t p = piece_of_[static_cast<std::size_t>(v)];
+    if (p < 0 || (only_piece >= 0 && p != only_piece)) one_body = false;
+    only_piece = p;
+  }
+  one_body = one_body && only_piece >= 0;
+  std::vector<std::int32_t> boundary;  // seed indices of removed faces' vertices that keep faces
+  for (std::size_t i = 0; i < cluster.size(); ++i)
+    if (!vertex_faces_[static_cast<std::size_t>(seeds[i])].empty())
+      boundary.push_back(std::int32_t(i));
+  std::vector<std::int32_t> cluster_group(cluster.size(), -1);
+  auto body_unbroken = [&]() {
+    bool proven = true;
+    for (const auto i : boundary) {
+      auto& g = cluster_group[static_cast<std::size_t>(cluster_root(i))];
+      const std::int32_t r =
+          root_of(search_label_[static_cast<std::size_t>(seeds[static_cast<std::size_t>(i)])]);
+      if (g < 0) g = r;
+      if (g != r) {
+        proven = false;
+        break;
+      }
+    }
+    for (const auto i : boundary) cluster_group[static_cast<std::size_t>(cluster_root(i))] = -1;
+    for (std::size_t k = 0; k < active.size() && proven; ++k)
+      proven = has_old[static_cast<std::size_t>(root_of(active[k]))];
+    return proven;
+  };
+  bool merged = false;
   while (!active.empty()) {
+    if (merged && one_body && !to_the_end && growing > 1 && body_unbroken()) {
+      // One group for the body: every group holding an old vertex.
+      open_piece = only_piece;
+      for (std::size_t s = 0; s < searches.size(); ++s) {
+        const std::int32_t r = root_of(std::int32_t(s));
+        if (!has_old[static_cast<std::size_t>(r)]) continue;
+        if (open_root < 0) open_root = r;
+        searches[static_cast<std::size_t>(r)].root = open_root;
+      }
+      break;
+    }
+    merged = false;
     if (growing == 1 && !to_the_end) {
       // Which bodies does the growing group touch so far?
       const std::int32_t root = root_of(active[0]);
@@ -980,11 +1055,14 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
             label = s;
             auto& grow = searches[static_cast<std::size_t>(s)];
             grow.queue.push_back(w);
+            if (w < v0) has_old[static_cast<std::size_t>(rs)] = 1;
             continue;
           }
           const std::int32_t rw = root_of(label);
           if (rw == rs) continue;
           const std::int32_t r = std::min(rw, rs), o = std::max(rw, rs);
+          merged = true;
+          has_old[static_cast<std::size_t>(r)] |= has_old[static_cast<std::size_t>(o)];
           auto& pr = pending_in[static_cast<std::size_t>(r)];
           auto& po = pending_in[static_cast<std::size_t>(o)];
           if (pr > 0 && po > 0) --growing;

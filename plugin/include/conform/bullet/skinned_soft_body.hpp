@@ -278,6 +278,7 @@ class SkinnedSoftBody {
   std::int32_t detached_count_ = 0;
   // Split search scratch (per vertex, −1 between searches).
   std::vector<std::int32_t> search_label_;
+  std::vector<std::int32_t> seed_slot_;  // per vertex: its index among a change's seeds (−1)
   std::vector<std::int32_t> move_slot_;  // per vertex: its node in a new body (−1 between)
   // Links removed during one change whose link may come back: (a, b, c, d, rest), where (a, b)
   // is the key edge and (c, d) the end vertices (equal to (a, b) for an edge link).
