@@ -5,6 +5,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <stdexcept>
 
@@ -16,7 +17,8 @@ struct Axis {
   Eigen::Vector3d b, u;    // base and unit direction towards the tip
   Eigen::Vector3d e1, e2;  // an orthonormal frame of the plane Π, with u right-handed
   double length = 0, r2 = 0;
-  Axis(const DrillTool& tool) : b(tool.base), r2(tool.radius * tool.radius) {
+  Axis() = default;
+  explicit Axis(const DrillTool& tool) : b(tool.base), r2(tool.radius * tool.radius) {
     length = (tool.tip - tool.base).norm();
     u = (tool.tip - tool.base) / length;
     int k0 = 0;
@@ -55,7 +57,9 @@ int edge_roots(const Eigen::Vector2d& mu, const Eigen::Vector2d& nu, double r2, 
 }
 
 // Open addressing (linear probing, Fibonacci hashing) from a 64-bit key to an int32, for the
-// drill's scratch tables of a few dozen to a few thousand entries. No erase.
+// drill's scratch tables of a few dozen to a few thousand entries. No erase; clear() is O(1):
+// a slot is live only when stamped with the current epoch, so a table kept between drills
+// (see Region) is reused without being swept.
 class FlatMap {
  public:
   static constexpr std::int32_t kNone = -1;
@@ -64,22 +68,29 @@ class FlatMap {
     while (cap < 2 * expected) cap *= 2;
     rehash(cap);
   }
+  void clear() {
+    size_ = 0;
+    if (++epoch_ == 0) {  // the stamps wrapped: sweep once
+      for (Slot& s : slots_) s.epoch = 0;
+      epoch_ = 1;
+    }
+  }
   std::int32_t find(std::uint64_t key) const {
     for (std::size_t s = home(key);; s = (s + 1) & mask_) {
+      if (slots_[s].epoch != epoch_) return kNone;
       if (slots_[s].key == key) return slots_[s].value;
-      if (slots_[s].key == kEmpty) return kNone;
     }
   }
   /// Inserts key → value, or overwrites the value when `overwrite`; returns the stored value.
   std::int32_t insert(std::uint64_t key, std::int32_t value, bool overwrite = false) {
     if (2 * (size_ + 1) > slots_.size()) rehash(2 * slots_.size());
     std::size_t s = home(key);
-    for (; slots_[s].key != kEmpty; s = (s + 1) & mask_)
+    for (; slots_[s].epoch == epoch_; s = (s + 1) & mask_)
       if (slots_[s].key == key) {
         if (overwrite) slots_[s].value = value;
         return slots_[s].value;
       }
-    slots_[s] = {key, value};
+    slots_[s] = {key, value, epoch_};
     ++size_;
     return value;
   }
@@ -88,25 +99,28 @@ class FlatMap {
   }
 
  private:
-  static constexpr std::uint64_t kEmpty = ~std::uint64_t(0);
   struct Slot {
     std::uint64_t key;
     std::int32_t value;
+    std::uint32_t epoch;  // live when equal to epoch_
   };
   std::size_t home(std::uint64_t key) const {
     return std::size_t((key * 0x9E3779B97F4A7C15ull) >> shift_);
   }
   void rehash(std::size_t capacity) {
     std::vector<Slot> old = std::move(slots_);
-    slots_.assign(capacity, Slot{kEmpty, kNone});
+    const std::uint32_t live = epoch_;
+    slots_.assign(capacity, Slot{0, kNone, 0});
+    epoch_ = 1;
     mask_ = capacity - 1;
     shift_ = 64 - std::countr_zero(capacity);
     size_ = 0;
     for (const Slot& o : old)
-      if (o.key != kEmpty) insert(o.key, o.value);
+      if (o.epoch == live) insert(o.key, o.value);
   }
   std::vector<Slot> slots_;
   std::size_t mask_ = 0, size_ = 0;
+  std::uint32_t epoch_ = 1;
   int shift_ = 64;
 };
 
@@ -137,7 +151,7 @@ struct Patch {
   std::vector<std::int32_t> rim;  // its rim loop (mesh indices), in boundary order; empty: none
   bool cut = false;
   int crossings = 0;  // rim crossings of its edges (refinement's count)
-  double limit = 0;   // the longest edge allowed for a face the rim crosses
+  double limit = 0;   // the longest chord of the rim polygon a face may hold
 };
 
 DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index,
@@ -244,8 +258,15 @@ class Region {
     bool seed = false;  // pierced by the axis
   };
 
-  Region(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis& axis)
-      : mesh_(mesh), adjacency_(adjacency), axis_(axis) {}
+  // One Region per thread is kept between drills, so that its tables are reused (a haptic
+  // loop drills often; fresh tables cost more in allocation and page faults than in use).
+  void reset(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis& axis) {
+    mesh_ = &mesh, adjacency_ = &adjacency, axis_ = axis;
+    verts.clear(), faces.clear(), origins.clear(), touched.clear();
+    vertex_of_.clear(), face_of_.clear(), pending_.clear();
+    work.clear(), fate.clear(), added.clear(), hole_edges.clear();
+    crossing_vertex.clear(), next.clear();
+  }
 
   std::vector<Vertex> verts;
   std::vector<LocalFace> faces;
@@ -256,7 +277,7 @@ class Region {
   std::int32_t vertex(std::int32_t g) {
     const std::int32_t known = vertex_of_.find(std::uint64_t(g));
     if (known >= 0) return known;
-    const Eigen::Vector3d x = mesh_.current.col(g);
+    const Eigen::Vector3d x = mesh_->current.col(g);
     // Only the positions the drill reads are checked (a whole-mesh check is O(V)).
     if (!x.allFinite()) throw std::invalid_argument("drill: non-finite positions");
     Vertex v;
@@ -288,7 +309,7 @@ class Region {
   std::int32_t load_face(std::int32_t g, std::int32_t patch) {
     const auto lf = static_cast<std::int32_t>(faces.size());
     face_of_.insert(std::uint64_t(g), lf);
-    const Face& t = mesh_.faces[std::size_t(g)];
+    const Face& t = mesh_->faces[std::size_t(g)];
     LocalFace f{{vertex(t[0]), vertex(t[1]), vertex(t[2])},
                 {kBoundary, kBoundary, kBoundary},
                 static_cast<std::int32_t>(origins.size()),
@@ -301,7 +322,7 @@ class Region {
       const std::int32_t other = pending_.find(std::uint64_t(h));
       if (other >= 0) {
         link(here, other);
-      } else if (const std::int32_t gh = adjacency_.twin(h); gh >= 0) {
+      } else if (const std::int32_t gh = adjacency_->twin(h); gh >= 0) {
         set_twin(here, -2 - gh);
       }
     }
@@ -316,7 +337,7 @@ class Region {
     return edge_roots(mu, nu, axis_.r2, roots) == 2;
   }
   bool face_near(std::int32_t g) {
-    const Face& t = mesh_.faces[std::size_t(g)];
+    const Face& t = mesh_->faces[std::size_t(g)];
     const std::int32_t a = vertex(t[0]), b = vertex(t[1]), c = vertex(t[2]);
     return edge_near(a, b) || edge_near(b, c) || edge_near(c, a);
   }
@@ -329,7 +350,7 @@ class Region {
     for (; head < faces.size(); ++head) {
       const std::int32_t from = origins[std::size_t(faces[head].origin)].face;
       for (int k = 0; k < 3; ++k) {
-        const std::int32_t n = adjacency_.neighbor(from, k);
+        const std::int32_t n = adjacency_->neighbor(from, k);
         if (n < 0 || loaded(n) >= 0 || !face_near(n)) continue;
         load_face(n, patch);
       }
@@ -445,9 +466,43 @@ class Region {
     return origins[std::size_t(t.origin)].seed && contains_axis(f);
   }
 
+  // How far apart (on Π) the rim's crossings of face f's edges are: the longest chord of the
+  // rim polygon that f will hold; +∞ when the whole disc lies inside the pierced face f, 0
+  // when the rim does not cross f.
+  double rim_extent(std::int32_t f) const {
+    const LocalFace& t = faces[std::size_t(f)];
+    Eigen::Vector2d points[6];
+    int n = 0, in = 0;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d &mu = verts[std::size_t(t.v[k])].q,
+                            &nu = verts[std::size_t(t.v[(k + 1) % 3])].q;
+      in += inside(mu);
+      double roots[2];
+      const int count = edge_roots(mu, nu, axis_.r2, roots);
+      if (inside(mu) != inside(nu) || count == 2)
+        for (int i = 0; i < count; ++i) points[n++] = mu + roots[i] * (nu - mu);
+    }
+    if (in == 3) return 0;
+    if (n < 2)
+      return in == 0 && origins[std::size_t(t.origin)].seed && contains_axis(f)
+                 ? std::numeric_limits<double>::infinity()
+                 : 0;
+    double extent = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) extent = std::max(extent, (points[i] - points[j]).norm());
+    return extent;
+  }
+
   std::int32_t twin(std::int32_t h) const { return faces[std::size_t(h / 3)].twin[h % 3]; }
 
   std::vector<std::int32_t> touched;  // faces written by bisect() since the caller cleared it
+
+  // drill_impl's scratch, kept with the rest.
+  std::vector<std::int32_t> work;
+  std::vector<std::uint8_t> fate;
+  std::vector<Face> added;
+  std::vector<std::array<std::int32_t, 3>> hole_edges;
+  FlatMap crossing_vertex{64}, next{64};
 
  private:
   void link(std::int32_t h, std::int32_t t) {
@@ -460,9 +515,9 @@ class Region {
     if (code <= -2) pending_.insert(std::uint64_t(-2 - code), h, true);
   }
 
-  const SkinnedMesh& mesh_;
-  const Adjacency& adjacency_;
-  const Axis& axis_;
+  const SkinnedMesh* mesh_ = nullptr;
+  const Adjacency* adjacency_ = nullptr;
+  Axis axis_;
   FlatMap vertex_of_{256}, face_of_{128}, pending_{128};
 };
 
@@ -595,7 +650,8 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
   }
 
   // 1–2. The patches: one breadth-first walk from each pierced face not yet reached.
-  Region region(mesh, adjacency, axis);
+  thread_local Region region;
+  region.reset(mesh, adjacency, axis);
   std::vector<Patch> patches;
   for (auto s : seeds) {
     if (region.loaded(s) >= 0) continue;
@@ -615,16 +671,16 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     p.entering = n.dot(axis.u) < 0;
   }
 
-  // 3–4. Refinement where the rim crosses: a face it crosses longer than the patch's limit is
-  // bisected (longest edge first, neighbours kept conforming), until its faces are short
-  // enough for the area (chords ≤ 1.5 × the circumference / min_rim_points: the inscribed
-  // polygon loses ≈ θ²/6 of πr² for chords of angle θ) and the rim crosses at least
-  // min_rim_points edges, else the limit halves. A face's depth counts its bisections; two
-  // bisections halve a triangle like one 1-to-4 split, so `refinements` reports depth / 2.
+  // 3–4. Refinement where the rim crosses: a face holding a chord of the rim polygon longer
+  // than the patch's limit is bisected (longest edge first, neighbours kept conforming). The
+  // inscribed polygon loses Σ r²(θ − sin θ)/2 ≈ πr² θ²/6 at most for chords of angle ≤ θ: the
+  // limit, 1.2 × the circumference / min_rim_points (θ ≈ 0.31 for 24), keeps that under 1.7 %;
+  // it shrinks while a patch has fewer than min_rim_points crossings. A face's depth counts
+  // its bisections; two halve a triangle as one 1-to-4 split does: `refinements` is depth / 2.
   const int min_rim = std::max(options.min_rim_points, 3);
   const int max_depth = 2 * std::max(options.max_refinements, 0);
-  for (auto& p : patches) p.limit = 1.5 * 2 * std::numbers::pi * tool.radius / min_rim;
-  std::vector<std::int32_t> work;
+  for (auto& p : patches) p.limit = 1.2 * 2 * std::numbers::pi * tool.radius / min_rim;
+  auto& work = region.work;
   for (int pass = 0;; ++pass) {
     work.clear();
     for (std::size_t f = region.faces.size(); f-- > 0;) work.push_back(std::int32_t(f));
@@ -632,9 +688,7 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
       const std::int32_t f = work.back();
       work.pop_back();
       const Region::LocalFace& lf = region.faces[std::size_t(f)];
-      const double limit = patches[std::size_t(lf.patch)].limit;
-      if (lf.depth >= max_depth || !region.crossed(f) ||
-          region.edge_length2(f, region.longest_edge(f)) <= limit * limit)
+      if (lf.depth >= max_depth || region.rim_extent(f) <= patches[std::size_t(lf.patch)].limit)
         continue;
       region.touched.clear();
       region.refine(f);
@@ -654,7 +708,7 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     }
     bool again = false;
     for (auto& p : patches)
-      if (p.crossings < min_rim && pass < max_depth) p.limit *= 0.5, again = true;
+      if (p.crossings < min_rim && pass < max_depth) p.limit *= 0.75, again = true;
     if (!again) break;
   }
   int depth = 0;
@@ -685,7 +739,8 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
         vb.side = 0, ++result.snapped_rim_vertices;
     }
   // Faces with a vertex inside are removed (2) or, with one outside too, clipped (1).
-  std::vector<std::uint8_t> fate(region.faces.size(), 0);
+  auto& fate = region.fate;
+  fate.assign(region.faces.size(), 0);
   for (std::size_t f = 0; f < region.faces.size(); ++f) {
     const Region::LocalFace& lf = region.faces[f];
     bool in = false, out = false;
@@ -699,7 +754,7 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     patches[std::size_t(lf.patch)].cut = true;
     ++result.removed_area_faces;
   }
-  FlatMap crossing_vertex(64);
+  auto& crossing_vertex = region.crossing_vertex;
   auto cross_vertex = [&](std::int32_t u, std::int32_t w) {
     const std::int32_t a = std::min(u, w), b = std::max(u, w);
     const std::int32_t made = static_cast<std::int32_t>(region.verts.size());
@@ -715,8 +770,8 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
   };
   // The faces that replace the modified original faces (local vertices), and the hole's
   // boundary half-edges (the surface on their left) per patch, for the tube.
-  std::vector<Face> added;
-  std::vector<std::array<std::int32_t, 3>> hole_edges;  // (patch, from, to)
+  auto& added = region.added;
+  auto& hole_edges = region.hole_edges;  // (patch, from, to)
   for (std::size_t f = 0; f < region.faces.size(); ++f) {
     const Region::LocalFace& lf = region.faces[f];
     const auto& t = lf.v;
@@ -809,7 +864,8 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
   if (options.tube)
     for (std::size_t p = 0; p < patches.size(); ++p) {
       if (!patches[p].cut) continue;
-      FlatMap next(32);
+      auto& next = region.next;
+      next.clear();
       std::size_t count = 0;
       std::int32_t start = -1;
       bool simple = true;
