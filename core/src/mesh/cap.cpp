@@ -1,5 +1,7 @@
 #include "conform/mesh/cap.hpp"
 
+#include "conform/mesh/adjacency.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -139,12 +141,13 @@ bool ear_clip(const Pts& p, const std::vector<std::int32_t>& poly,
   return false;
 }
 
-// A strictly convex polygon (every turn > eps, counter-clockwise) triangulated as a strip from
-// its vertex farthest from the centroid (an end of its long axis), each step taking the
-// Delaunay diagonal of the quadrilateral at the strip's front. The usual cut section, close to
-// an ellipse, then comes out Delaunay already and the flips after it only confirm it (a
-// balanced ear clipping needs O(n) flips of O(n) cost each there). False when not strictly
-// convex.
+// A convex polygon (no turn below −eps, counter-clockwise) triangulated as a strip from its
+// corner farthest from the centroid (an end of its long axis), each step taking the Delaunay
+// diagonal of the quadrilateral at the strip's front unless that would make a flat triangle
+// (flat vertices: collinear runs of boundary points). The usual cut section, close to an
+// ellipse, then comes out Delaunay or nearly so, and the flips after it are few (a balanced
+// ear clipping needs O(n) flips of O(n) cost each there). False, with `out` as it was, when
+// the polygon is not convex or a step has no non-flat triangle.
 bool convex_strip(const Pts& p, const std::vector<std::int32_t>& poly,
                   std::vector<std::array<std::int32_t, 3>>& out) {
   const auto m = static_cast<std::int32_t>(poly.size());
@@ -158,17 +161,22 @@ bool convex_strip(const Pts& p, const std::vector<std::int32_t>& poly,
     scale = std::max(scale, P(k).cwiseAbs().maxCoeff()), centroid += P(k);
   centroid /= m;
   const double eps = 1e-14 * scale * scale;
-  std::int32_t start = 0;
+  std::int32_t start = -1;
   double far = -1;
   for (std::int32_t k = 0; k < m; ++k) {
-    if (!(cross(P((k + m - 1) % m), P(k), P((k + 1) % m)) > eps)) return false;
+    const double turn = cross(P((k + m - 1) % m), P(k), P((k + 1) % m));
+    if (turn < -eps) return false;
     const double d = (P(k) - centroid).squaredNorm();
-    if (d > far) far = d, start = k;
+    if (turn > eps && d > far) far = d, start = k;
   }
+  if (start < 0) return false;
   auto id = [&](std::int32_t k) { return poly[static_cast<std::size_t>(k)]; };
+  auto solid = [&](std::int32_t a, std::int32_t b, std::int32_t c) {
+    return cross(P(a), P(b), P(c)) > eps;
+  };
+  const std::size_t first = out.size();
   std::int32_t r = (start + m - 1) % m, l = (start + 1) % m;
   out.push_back({id(r), id(start), id(l)});
-  if (m == 3) return true;
   for (std::int32_t remaining = m - 1; remaining > 3; --remaining) {
     const std::int32_t ahead = (l + 1) % m, behind = (r + m - 1) % m;
     // The quadrilateral (behind, r, l, ahead): diagonal (r, ahead) when `ahead` lies inside
@@ -177,12 +185,23 @@ bool convex_strip(const Pts& p, const std::vector<std::int32_t>& poly,
     const double in = u.squaredNorm() * (v.x() * w.y() - v.y() * w.x()) -
                       v.squaredNorm() * (u.x() * w.y() - u.y() * w.x()) +
                       w.squaredNorm() * (u.x() * v.y() - u.y() * v.x());
-    if (in > 0)
+    const bool take_ahead = solid(r, l, ahead), take_behind = solid(behind, r, l);
+    if (take_ahead && (in > 0 || !take_behind)) {
       out.push_back({id(r), id(l), id(ahead)}), l = ahead;
-    else
+    } else if (take_behind) {
       out.push_back({id(behind), id(r), id(l)}), r = behind;
+    } else {
+      out.resize(first);
+      return false;
+    }
   }
-  out.push_back({id(r), id(l), id((l + 1) % m)});
+  if (m > 3) {
+    if (!solid(r, l, (l + 1) % m)) {
+      out.resize(first);
+      return false;
+    }
+    out.push_back({id(r), id(l), id((l + 1) % m)});
+  }
   return true;
 }
 
@@ -391,6 +410,126 @@ bool ear_clip_section(const std::vector<Pts>& loops, SectionTriangulation& out) 
   return true;
 }
 
+// Flat vertices: a cut across a mesh of quads split into triangles crosses each quad's
+// diagonal on the straight segment between its two side crossings, so every other vertex of
+// such a section lies on the line through its neighbours (within rounding). Those vertices
+// make the loop non-strictly convex (no strip), and their orientation tests sit at the limit
+// of floating point (CGAL's filters fail there and fall back to exact arithmetic). So they are
+// taken out, the remaining corners triangulated, and each run of flat vertices put back by
+// splitting the one section triangle on its edge into a fan from that triangle's third vertex
+// (its triangles keep a positive area: that vertex is off the line). The flips that follow
+// make the whole constrained Delaunay again.
+struct Corners {
+  std::vector<Pts> loops;               // the loops without their flat vertices
+  std::vector<std::int32_t> original;   // corner (loops concatenated) → vertex (the same)
+  std::vector<std::int32_t> run_start;  // per corner: the first flat vertex after it, or −1
+  std::vector<std::int32_t> run_length;
+  bool any_flat = false;
+};
+
+Corners find_corners(const std::vector<Pts>& loops) {
+  Corners c;
+  c.loops.resize(loops.size());
+  std::int32_t base = 0;
+  for (std::size_t l = 0; l < loops.size(); ++l) {
+    const Pts& q = loops[l];
+    const auto m = static_cast<std::int32_t>(q.size());
+    double scale = 0;
+    for (const auto& x : q) scale = std::max(scale, x.cwiseAbs().maxCoeff());
+    const double eps = 1e-14 * scale * scale;
+    std::vector<std::uint8_t> flat(static_cast<std::size_t>(m), 0);
+    std::int32_t corners = 0;
+    for (std::int32_t k = 0; k < m; ++k) {
+      const Eigen::Vector2d &a = q[static_cast<std::size_t>((k + m - 1) % m)],
+                            &b = q[static_cast<std::size_t>(k)],
+                            &d = q[static_cast<std::size_t>((k + 1) % m)];
+      const double along = (b - a).dot(d - a);  // b strictly between a and d, not a spike
+      flat[static_cast<std::size_t>(k)] =
+          std::abs(cross(a, b, d)) <= eps && along > 0 && along < (d - a).squaredNorm();
+      corners += !flat[static_cast<std::size_t>(k)];
+    }
+    if (corners < 3 || corners == m) {  // nothing to take out, or too little would be left
+      for (std::int32_t k = 0; k < m; ++k) {
+        c.loops[l].push_back(q[static_cast<std::size_t>(k)]);
+        c.original.push_back(base + k);
+        c.run_start.push_back(-1), c.run_length.push_back(0);
+      }
+      base += m;
+      continue;
+    }
+    c.any_flat = true;
+    std::int32_t k0 = 0;
+    while (flat[static_cast<std::size_t>(k0)]) ++k0;  // start at a corner
+    for (std::int32_t j = 0; j < m;) {
+      const std::int32_t k = (k0 + j) % m;
+      c.loops[l].push_back(q[static_cast<std::size_t>(k)]);
+      c.original.push_back(base + k);
+      std::int32_t run = 0;
+      while (flat[static_cast<std::size_t>((k + 1 + run) % m)]) ++run;
+      c.run_start.push_back(run > 0 ? base + (k + 1) % m : -1);
+      c.run_length.push_back(run);
+      j += 1 + run;
+    }
+    base += m;
+  }
+  return c;
+}
+
+// Puts the flat vertices back (see Corners): `out` holds the corners' triangulation, in
+// vertex ids already. Flat vertices of a loop follow one another in the loop's order, so the
+// run after corner a (to the next corner b) is run_start .. run_start + length − 1, wrapping
+// within the loop.
+bool put_back_flat(const std::vector<Pts>& loops, const Corners& c, SectionTriangulation& out) {
+  // Directed edge → triangle. Splitting a triangle moves one of its other edges into a new
+  // triangle: that entry is overwritten, so later runs on it find where it went.
+  EdgeMap where;
+  where.reserve(3 * out.triangles.size());
+  for (std::size_t t = 0; t < out.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+      where.insert(out.triangles[t][static_cast<std::size_t>(k)],
+                   out.triangles[t][static_cast<std::size_t>((k + 1) % 3)],
+                   static_cast<std::int32_t>(t), true);
+  auto find = [&](std::int32_t u, std::int32_t v) { return where.find(u, v); };
+  std::vector<std::int32_t> loop_start(loops.size() + 1, 0);
+  for (std::size_t l = 0; l < loops.size(); ++l)
+    loop_start[l + 1] = loop_start[l] + static_cast<std::int32_t>(loops[l].size());
+  auto loop_of = [&](std::int32_t v) {
+    return static_cast<std::size_t>(std::upper_bound(loop_start.begin(), loop_start.end(), v) -
+                                    loop_start.begin() - 1);
+  };
+  std::vector<std::int32_t> run;
+  const std::size_t n = c.original.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (c.run_length[i] == 0) continue;
+    const std::int32_t a = c.original[i];
+    const std::size_t l = loop_of(a);
+    const std::int32_t lo = loop_start[l], size = loop_start[l + 1] - lo;
+    run.clear();
+    for (std::int32_t j = 0; j < c.run_length[i]; ++j)
+      run.push_back(lo + (c.run_start[i] - lo + j) % size);
+    const std::int32_t b = lo + (run.back() - lo + 1) % size;
+    // The section lies on one side of the loop edge (a, b): the triangle holding it holds
+    // either a → b or b → a.
+    std::int32_t t = find(a, b);
+    bool forward = true;
+    if (t < 0) t = find(b, a), forward = false;
+    if (t < 0) return false;
+    std::array<std::int32_t, 3>& tri = out.triangles[static_cast<std::size_t>(t)];
+    std::int32_t apex = -1;
+    for (auto v : tri)
+      if (v != a && v != b) apex = v;
+    if (!forward) std::reverse(run.begin(), run.end());
+    const std::int32_t from = forward ? a : b, to = forward ? b : a;
+    // (from, to, apex) → (from, r0, apex), (r0, r1, apex), …, (r_last, to, apex).
+    tri = {from, run.front(), apex};
+    for (std::size_t j = 0; j + 1 < run.size(); ++j)
+      out.triangles.push_back({run[j], run[j + 1], apex});
+    out.triangles.push_back({run.back(), to, apex});
+    where.insert(to, apex, static_cast<std::int32_t>(out.triangles.size() - 1), true);
+  }
+  return true;
+}
+
 }  // namespace
 
 bool has_cgal_triangulator() {
@@ -414,9 +553,29 @@ SectionTriangulation triangulate_section(const std::vector<std::vector<Eigen::Ve
   if (method == SectionTriangulator::Best)
     method = detail::cdt_available() ? SectionTriangulator::ConstrainedDelaunay
                                      : SectionTriangulator::EarClipping;
-  const bool ok = method == SectionTriangulator::ConstrainedDelaunay
-                      ? detail::cdt_section(loops, out)
-                      : ear_clip_section(loops, out);
+  auto triangulate = [&](const std::vector<Pts>& l) {
+    return method == SectionTriangulator::ConstrainedDelaunay ? detail::cdt_section(l, out)
+                                                              : ear_clip_section(l, out);
+  };
+  const Corners corners =
+      method == SectionTriangulator::ConstrainedDelaunay ? find_corners(loops) : Corners{};
+  bool ok = false;
+  // Ear clipping strips convex loops with their flat vertices in place; CGAL gets the corners.
+  if (method == SectionTriangulator::ConstrainedDelaunay && corners.any_flat &&
+      triangulate(corners.loops)) {
+    for (auto& t : out.triangles)
+      for (auto& v : t) v = corners.original[static_cast<std::size_t>(v)];
+    ok = put_back_flat(loops, corners, out);
+    if (ok) {
+      Pts all;
+      for (const auto& l : loops) all.insert(all.end(), l.begin(), l.end());
+      delaunay_flips(all, out.triangles, 0);
+    }
+  }
+  if (!ok) {  // no flat vertices, or the corners alone did not triangulate: the loops as given
+    out = SectionTriangulation{};
+    ok = triangulate(loops);
+  }
   if (!ok) {
     out.triangles.clear();
     if (out.problem.empty()) out.problem = "the section could not be triangulated";
