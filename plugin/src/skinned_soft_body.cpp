@@ -546,16 +546,20 @@ void SkinnedSoftBody::remove_bending(std::int32_t a, std::int32_t b) {
 
 void SkinnedSoftBody::remove_link(std::int32_t p, std::int32_t li) {
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
+  const auto [a, b] = piece.link_key[static_cast<std::size_t>(li)];
+  (piece.link_bend[static_cast<std::size_t>(li)] ? bend_link_ : edge_link_).erase(a, b, li);
+  pop_link(p, li);
+  ++stats_.removed_links;
+}
+
+void SkinnedSoftBody::pop_link(std::int32_t p, std::int32_t li) {
+  // Swap-with-last; the key of the link that fills the hole is updated, li's own is left to
+  // the caller.
+  Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
   const int last = body.m_links.size() - 1;
   const auto l = static_cast<std::size_t>(li), e = static_cast<std::size_t>(last);
-  {
-    const auto [a, b] = piece.link_key[l];
-    if (piece.link_bend[l])
-      bend_link_.erase(a, b, li), --piece.bending;
-    else
-      edge_link_.erase(a, b, li);
-  }
+  piece.bending -= piece.link_bend[l];
   if (li != last) {
     body.m_links[li] = body.m_links[last];
     piece.rest[l] = piece.rest[e];
@@ -568,7 +572,6 @@ void SkinnedSoftBody::remove_link(std::int32_t p, std::int32_t li) {
   piece.rest.pop_back();
   piece.link_key.pop_back();
   piece.link_bend.pop_back();
-  ++stats_.removed_links;
 }
 
 void SkinnedSoftBody::keep_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
@@ -728,8 +731,7 @@ std::int32_t SkinnedSoftBody::move_to_new_piece(std::span<const std::int32_t> mo
     into.face_id.push_back(f);
   }
   // Links: copied, then out of the old body, highest index first (the tail is popped without
-  // a swap). Their keys are entered once all have left (an old entry's removal must not meet
-  // a new one).
+  // a swap). Their keys stay in the edge maps and get the new index once all have left.
   for (std::size_t s = 0; s < sources.size(); ++s) {
     const std::int32_t p = sources[s];
     const Piece& from = *pieces_[static_cast<std::size_t>(p)];
@@ -747,10 +749,9 @@ std::int32_t SkinnedSoftBody::move_to_new_piece(std::span<const std::int32_t> mo
       into.link_key.push_back(from.link_key[l]);
       into.link_bend.push_back(from.link_bend[l]);
       into.bending += from.link_bend[l];
-      remove_link(p, li);
+      pop_link(p, li);  // its key stays, re-aimed below
     }
   }
-  stats_.removed_links -= std::int32_t(link_count);  // moved, not removed
   for (std::size_t i = 0; i < into.link_key.size(); ++i)
     (into.link_bend[i] ? bend_link_ : edge_link_)
         .insert(into.link_key[i].first, into.link_key[i].second, std::int32_t(i), true);

@@ -225,6 +225,7 @@ class SkinnedSoftBody {
   std::int32_t move_to_new_piece(std::span<const std::int32_t> moving, std::int32_t joining,
                                  std::int32_t added_faces);
   void remove_link(std::int32_t piece, std::int32_t link);
+  void pop_link(std::int32_t piece, std::int32_t link);  // out of Bullet, key kept
   void add_link(std::int32_t piece, std::int32_t u, std::int32_t v, double rest);
   void add_bending(std::int32_t piece, std::int32_t a, std::int32_t b, std::int32_t c,
                    std::int32_t d, double rest);
