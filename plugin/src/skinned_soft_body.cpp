@@ -94,55 +94,95 @@ std::uint32_t spread_bits(std::uint32_t x) {
   return x;
 }
 
+// Takes a leaf out of its tree without freeing anything: its parent (now redundant, its
+// other child takes its place) and the leaf itself go to `pool`, for the tree of another body.
+// Unlike btDbvt::remove, no ancestor is refitted here (see refit_tree).
+void unlink_leaf(btDbvt& tree, btDbvtNode* leaf, std::vector<btDbvtNode*>& pool) {
+  pool.push_back(leaf);
+  --tree.m_leaves;
+  if (leaf == tree.m_root) {
+    tree.m_root = nullptr;
+    return;
+  }
+  btDbvtNode* parent = leaf->parent;
+  btDbvtNode* sibling = parent->childs[parent->childs[0] == leaf ? 1 : 0];
+  btDbvtNode* grand = parent->parent;
+  sibling->parent = grand;
+  if (grand)
+    grand->childs[grand->childs[1] == parent ? 1 : 0] = sibling;
+  else
+    tree.m_root = sibling;
+  pool.push_back(parent);
+}
+
+// Recomputes every internal volume from its children (after many leaves were unlinked: one
+// pass over the tree instead of a refit walk per leaf).
+void refit_tree(btDbvtNode* node) {
+  if (!node || node->isleaf()) return;
+  refit_tree(node->childs[0]);
+  refit_tree(node->childs[1]);
+  Merge(node->childs[0]->volume, node->childs[1]->volume, node->volume);
+}
+
 // Builds the node tree (m_ndbvt) of a body whose nodes have no leaves yet, in one pass: leaves
 // as appendNode makes them (the node's position, the body's margin), joined in Morton order
 // into a balanced tree. One insert per node walks the growing tree and costs several times
-// more. Tree nodes come from btAlignedAlloc, as btDbvt's own (it frees them).
-void build_node_tree(btSoftBody& body) {
+// more. Tree nodes come from `pool` (nodes unlinked from another tree) and then from
+// btAlignedAlloc, as btDbvt's own (it frees them); what the pool has left over is freed.
+void build_node_tree(btSoftBody& body, std::vector<btDbvtNode*>& pool) {
   const int n = body.m_nodes.size();
-  if (n == 0) return;
-  const btScalar margin = body.getCollisionShape()->getMargin();
-  btVector3 lo = body.m_nodes[0].m_x, hi = lo;
-  for (int i = 1; i < n; ++i) {
-    lo.setMin(body.m_nodes[i].m_x);
-    hi.setMax(body.m_nodes[i].m_x);
-  }
-  const btVector3 extent = hi - lo;
-  const btScalar size = std::max({extent.x(), extent.y(), extent.z(), btScalar(1e-9)});
-  const btScalar scale = btScalar(1023) / size;
-  std::vector<std::pair<std::uint32_t, int>> order(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    const btVector3 q = (body.m_nodes[i].m_x - lo) * scale;
-    order[static_cast<std::size_t>(i)] = {spread_bits(std::uint32_t(q.x())) |
-                                              (spread_bits(std::uint32_t(q.y())) << 1) |
-                                              (spread_bits(std::uint32_t(q.z())) << 2),
-                                          i};
-  }
-  std::sort(order.begin(), order.end());
-  auto make = [](btDbvtNode* parent) {
-    auto* node = new (btAlignedAlloc(sizeof(btDbvtNode), 16)) btDbvtNode();
-    node->parent = parent;
-    return node;
-  };
-  auto build = [&](auto&& self, int first, int count, btDbvtNode* parent) -> btDbvtNode* {
-    btDbvtNode* node = make(parent);
-    if (count == 1) {
-      btSoftBody::Node& leaf = body.m_nodes[order[static_cast<std::size_t>(first)].second];
-      node->volume = btDbvtVolume::FromCR(leaf.m_x, margin);
-      node->data = &leaf;
-      node->childs[1] = nullptr;
-      leaf.m_leaf = node;
-      return node;
+  if (n > 0) {
+    const btScalar margin = body.getCollisionShape()->getMargin();
+    btVector3 lo = body.m_nodes[0].m_x, hi = lo;
+    for (int i = 1; i < n; ++i) {
+      lo.setMin(body.m_nodes[i].m_x);
+      hi.setMax(body.m_nodes[i].m_x);
     }
-    const int half = count / 2;
-    node->childs[0] = self(self, first, half, node);
-    node->childs[1] = self(self, first + half, count - half, node);
-    Merge(node->childs[0]->volume, node->childs[1]->volume, node->volume);
-    return node;
-  };
-  btDbvt& tree = body.m_ndbvt;
-  tree.m_root = build(build, 0, n, nullptr);
-  tree.m_leaves = n;
+    const btVector3 extent = hi - lo;
+    const btScalar size = std::max({extent.x(), extent.y(), extent.z(), btScalar(1e-9)});
+    const btScalar scale = btScalar(1023) / size;
+    std::vector<std::pair<std::uint32_t, int>> order(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      const btVector3 q = (body.m_nodes[i].m_x - lo) * scale;
+      order[static_cast<std::size_t>(i)] = {spread_bits(std::uint32_t(q.x())) |
+                                                (spread_bits(std::uint32_t(q.y())) << 1) |
+                                                (spread_bits(std::uint32_t(q.z())) << 2),
+                                            i};
+    }
+    std::sort(order.begin(), order.end());
+    auto make = [&](btDbvtNode* parent) {
+      btDbvtNode* node;
+      if (pool.empty()) {
+        node = new (btAlignedAlloc(sizeof(btDbvtNode), 16)) btDbvtNode();
+      } else {
+        node = pool.back();
+        pool.pop_back();
+      }
+      node->parent = parent;
+      return node;
+    };
+    auto build = [&](auto&& self, int first, int count, btDbvtNode* parent) -> btDbvtNode* {
+      btDbvtNode* node = make(parent);
+      if (count == 1) {
+        btSoftBody::Node& leaf = body.m_nodes[order[static_cast<std::size_t>(first)].second];
+        node->volume = btDbvtVolume::FromCR(leaf.m_x, margin);
+        node->data = &leaf;
+        node->childs[1] = nullptr;
+        leaf.m_leaf = node;
+        return node;
+      }
+      const int half = count / 2;
+      node->childs[0] = self(self, first, half, node);
+      node->childs[1] = self(self, first + half, count - half, node);
+      Merge(node->childs[0]->volume, node->childs[1]->volume, node->volume);
+      return node;
+    };
+    btDbvt& tree = body.m_ndbvt;
+    tree.m_root = build(build, 0, n, nullptr);
+    tree.m_leaves = n;
+  }
+  for (btDbvtNode* spare : pool) btAlignedFree(spare);
+  pool.clear();
 }
 
 }  // namespace
@@ -755,14 +795,26 @@ std::int32_t SkinnedSoftBody::move_to_new_piece(std::span<const std::int32_t> mo
   for (std::size_t i = 0; i < into.link_key.size(); ++i)
     (into.link_bend[i] ? bend_link_ : edge_link_)
         .insert(into.link_key[i].first, into.link_key[i].second, std::int32_t(i), true);
+  // Node tree leaves: unlinked from the old trees (one refit pass each afterwards instead of
+  // a refit walk per leaf) and reused, with their freed parents, for the new body's tree.
+  std::vector<btDbvtNode*> pool;
+  pool.reserve(std::size_t(2 * n));
+  for (const auto v : moving) {
+    btSoftBody& old = *body_of(v);
+    btSoftBody::Node& node = old.m_nodes[node_of_[static_cast<std::size_t>(v)]];
+    if (node.m_leaf) unlink_leaf(old.m_ndbvt, node.m_leaf, pool);
+    node.m_leaf = nullptr;
+  }
   remove_nodes_highest_first(moving);
+  for (const auto p : sources)
+    refit_tree(pieces_[static_cast<std::size_t>(p)]->body->m_ndbvt.m_root);
   for (int i = 0; i < n; ++i) {
     const auto v = static_cast<std::size_t>(moving[std::size_t(i)]);
     piece_of_[v] = into_index;
     node_of_[v] = i;
     move_slot_[v] = -1;
   }
-  build_node_tree(body);
+  build_node_tree(body, pool);
   stats_.moved_nodes += n;
   return into_index;
 }
