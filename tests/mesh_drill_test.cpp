@@ -5,6 +5,7 @@
 #include <numbers>
 #include <random>
 
+#include "conform/cga/versor.hpp"
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/face_index.hpp"
@@ -293,4 +294,219 @@ TEST(Drill, PropertyRandomTubesThroughTheArm) {
     if (testing::Test::HasFailure()) break;
   }
   EXPECT_GT(tubes, 135) << "most drills through the arm get their tube";
+}
+
+namespace {
+
+// Linear-blend skinning with one versor per bone, applied through the weights.
+Eigen::Matrix3Xd lbs(const SkinnedMesh& m, const std::vector<conform::cga::Versor<double>>& pose) {
+  Eigen::Matrix3Xd out(3, m.rest.cols());
+  for (Eigen::Index v = 0; v < m.rest.cols(); ++v) {
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int k = 0; k < kMaxInfluences; ++k)
+      if (m.weights(k, v) != 0)
+        x += m.weights(k, v) * pose[static_cast<std::size_t>(m.bones(k, v))].apply(m.rest.col(v));
+    out.col(v) = x;
+  }
+  return out;
+}
+
+double longest_edge(const SkinnedMesh& m) {
+  double longest = 0;
+  for (const Face& f : m.faces)
+    for (int k = 0; k < 3; ++k)
+      longest = std::max(longest, (m.current.col(f[k]) - m.current.col(f[(k + 1) % 3])).norm());
+  return longest;
+}
+
+// The smallest angle (radians) of the faces from slot `first` on.
+double smallest_angle(const SkinnedMesh& m, std::int32_t first) {
+  double smallest = std::numbers::pi;
+  for (std::int32_t f = first; f < m.face_count(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Face& t = m.faces[static_cast<std::size_t>(f)];
+      const Eigen::Vector3d a = m.current.col(t[(k + 1) % 3]) - m.current.col(t[k]),
+                            b = m.current.col(t[(k + 2) % 3]) - m.current.col(t[k]);
+      smallest = std::min(smallest, std::atan2(a.cross(b).norm(), a.dot(b)));
+    }
+  return smallest;
+}
+
+}  // namespace
+
+TEST(Drill, OneLocalChangeOfOriginalVertices) {
+  // Random drills through the arm (no tube): refinement and hole are one change; every new
+  // vertex is a combination of 2 or 3 ORIGINAL vertices (no nesting), used by a face (nothing
+  // orphaned inside the hole), the rim's last and on the cylinder; and only faces near the rim
+  // change: every removed face comes within r + 2 × the longest edge of the axis.
+  const SkinnedMesh arm = make_arm(1).mesh;
+  const double edge = longest_edge(arm);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  int holes = 0;
+  double farthest = 0, sharpest = std::numbers::pi;
+  for (int trial = 0; trial < 200; ++trial) {
+    SkinnedMesh m = arm;
+    Adjacency adj(m);
+    const Eigen::Vector3d c(0.02 * (u(rng) - 0.5), 0.02 * (u(rng) - 0.5), 0.05 + 0.55 * u(rng));
+    Eigen::Vector3d dir(u(rng) - 0.5, u(rng) - 0.5, 0.6 * (u(rng) - 0.5));
+    dir.normalize();
+    const DrillTool tool{c - 0.2 * dir, c + 0.2 * dir, 0.004 + 0.015 * u(rng)};
+    const DrillResult d = drill(m, adj, tool);
+    const std::string what = "trial " + std::to_string(trial);
+    if (d.holes == 0) continue;
+    holes += d.holes;
+    ASSERT_EQ(d.changes.size(), 1u) << what;
+    const TopologyChange& ch = d.changes[0];
+    const std::int32_t nv0 = ch.base_vertex_count;
+    std::vector<int> uses(static_cast<std::size_t>(m.vertex_count()), 0);
+    for (const Face& f : m.faces)
+      for (auto v : f) ++uses[static_cast<std::size_t>(v)];
+    for (std::size_t i = 0; i < ch.new_vertices.size(); ++i) {
+      const NewVertex& n = ch.new_vertices[i];
+      double sum = 0;
+      int parents = 0;
+      for (int k = 0; k < 3; ++k) {
+        if (n.parents[k] < 0) continue;
+        ++parents;
+        EXPECT_LT(n.parents[k], nv0) << what << ": new vertex " << i << " has a new parent";
+        EXPECT_GT(n.coefficients[k], 0) << what;
+        sum += n.coefficients[k];
+      }
+      EXPECT_GE(parents, 2) << what;
+      EXPECT_NEAR(sum, 1, 1e-12) << what;
+      EXPECT_GT(uses[static_cast<std::size_t>(nv0) + i], 0) << what << ": orphan new vertex " << i;
+    }
+    for (std::int32_t v = m.vertex_count() - d.rim_vertices; v < m.vertex_count(); ++v)
+      EXPECT_NEAR(std::sqrt(axis_distance_squared(tool, m.current.col(v))), tool.radius, 1e-9)
+          << what;
+    for (auto f : ch.removed_faces) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (auto v : arm.faces[static_cast<std::size_t>(f)])
+        nearest = std::min(nearest, std::sqrt(axis_distance_squared(tool, arm.current.col(v))));
+      farthest = std::max(farthest, (nearest - tool.radius) / edge);
+      EXPECT_LE(nearest, tool.radius + 2 * edge) << what << ": face " << f << " changed";
+    }
+    sharpest = std::min(sharpest, smallest_angle(m, 0));
+    if (testing::Test::HasFailure()) break;
+  }
+  EXPECT_GT(holes, 250);
+  RecordProperty("farthest_changed_face_in_edges", std::to_string(farthest));
+  RecordProperty("smallest_angle_degrees", std::to_string(sharpest * 180 / std::numbers::pi));
+}
+
+TEST(Drill, RimChordsOnASheet) {
+  // Flat sheets from coarse (the disc inside one face) to fine, random centres and radii: the
+  // hole's boundary has at least min_rim_points vertices, all on the cylinder (computed ones
+  // to 1e-9, snapped ones within snap_fraction of an edge), no chord longer than the
+  // refinement's limit (1.2 × 2πr / min_rim_points, see below for snapped vertices), and the
+  // removed area within 2 % of πr².
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  double worst_area = 0, worst_chord = 0, worst_snapped_chord = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = 4 + trial % 37;
+    SkinnedMesh m = make_sheet(n, n, 2.0, 2.0);  // border at ±1, beyond every hole
+    const double a0 = surface_area(m), edge = longest_edge(m);
+    Adjacency adj(m);
+    const double r = 0.03 + 0.12 * std::abs(u(rng));
+    const Eigen::Vector3d c(0.4 * u(rng), 0.4 * u(rng), 0);
+    const Eigen::Vector3d dir = Eigen::Vector3d(0.3 * u(rng), 0.3 * u(rng), 1).normalized();
+    const DrillTool tool{c + dir, c - dir, r};
+    const DrillOptions options;
+    const DrillResult d = drill(m, adj, tool, options);
+    const std::string what = "trial " + std::to_string(trial) + " n " + std::to_string(n);
+    ASSERT_EQ(d.holes, 1) << what << ": " << d.message;
+    // The hole's area on the sheet: πr² over the cosine of the tilt.
+    const double hole = std::numbers::pi * r * r / std::abs(dir.z());
+    worst_area = std::max(worst_area, std::abs(a0 - surface_area(m) - hole) / hole);
+    EXPECT_NEAR(a0 - surface_area(m), hole, 0.02 * hole) << what;
+    // The hole's boundary: the boundary edges away from the sheet's border.
+    Adjacency fresh(m);
+    int rim = 0;
+    for (std::int32_t h = 0; h < 3 * m.face_count(); ++h) {
+      if (fresh.twin(h) >= 0) continue;
+      const Face& f = m.faces[static_cast<std::size_t>(h / 3)];
+      const Eigen::Vector3d a = m.current.col(f[h % 3]), b = m.current.col(f[(h + 1) % 3]);
+      if (std::max(a.head<2>().cwiseAbs().maxCoeff(), b.head<2>().cwiseAbs().maxCoeff()) > 0.99)
+        continue;  // the sheet's own border
+      ++rim;
+      const double ra = std::sqrt(axis_distance_squared(tool, a));
+      EXPECT_NEAR(ra, r, options.snap_fraction * edge + 1e-9) << what;
+      // The chord on Π (the drill's cross-section), where the limit applies. Between two
+      // computed rim points (one face holds both) exactly; from a snapped vertex the rim point
+      // it replaces may lie further along a nearly tangent edge: within twice the limit.
+      const Eigen::Vector3d along = (b - a) - (b - a).dot(dir) * dir;
+      const double limit = 1.2 * 2 * std::numbers::pi * r / options.min_rim_points;
+      const double rb = std::sqrt(axis_distance_squared(tool, b));
+      const bool computed = std::abs(ra - r) <= 1e-9 && std::abs(rb - r) <= 1e-9;
+      (computed ? worst_chord : worst_snapped_chord) =
+          std::max(computed ? worst_chord : worst_snapped_chord, along.norm() / limit);
+      EXPECT_LE(along.norm(), (computed ? 1 + 1e-9 : 2) * limit)
+          << what << " snapped " << !computed;
+    }
+    EXPECT_GE(rim, options.min_rim_points) << what;
+    expect_valid(m, what);
+    if (testing::Test::HasFailure()) break;
+  }
+  RecordProperty("worst_area_error", std::to_string(worst_area));
+  RecordProperty("worst_chord_over_limit", std::to_string(worst_chord));
+  RecordProperty("worst_snapped_chord_over_limit", std::to_string(worst_snapped_chord));
+}
+
+TEST(Drill, ReDeformation) {
+  // Drill the posed arm, then re-skin the result with another pose, against skinning the
+  // original with that pose and applying the same change: new vertices whose parents share
+  // their influences deform exactly as the interpolation of their parents (1e-9); elsewhere
+  // LBS of an interpolated point differs from the interpolation by a t(1 − t) term only.
+  const SkinnedMesh original = make_arm(1).mesh;
+  using V = conform::cga::Versor<double>;
+  using M = conform::cga::Motor<double>;
+  const std::vector<V> pose1 = {V::identity(), V::from_motor(M::from_axis_angle({1, 0, 0}, 0.4)),
+                                V{M::from_axis_angle({0, 1, 0}, 0.3), 1.1}};
+  const std::vector<V> pose2 = {V::from_motor(M::from_translation({0.1, 0, 0})),
+                                V::from_motor(M::from_axis_angle({1, 1, 0}, -0.7)),
+                                V{M::from_axis_angle({0, 0, 1}, 0.5), 0.8}};
+  SkinnedMesh posed = original;
+  posed.current = lbs(original, pose1);
+  for (const double z : {0.15, 0.31, 0.42}) {  // upper arm, elbow, forearm
+    SkinnedMesh a = posed;
+    Adjacency adj(a);
+    // Across the posed limb, through the centre of the ring at rest height z (both walls),
+    // with the tube.
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    int ring = 0;
+    for (std::int32_t v = 0; v < posed.vertex_count(); ++v)
+      if (std::abs(original.rest(2, v) - z) < 0.01) c += posed.current.col(v), ++ring;
+    ASSERT_GT(ring, 0);
+    c /= ring;
+    DrillOptions options;
+    options.tube = true;
+    const DrillResult d = drill(
+        a, adj, {c + Eigen::Vector3d(0.3, 0.02, 0), c - Eigen::Vector3d(0.3, -0.02, 0), 0.008},
+        options);
+    ASSERT_EQ(d.holes, 2) << "z " << z << ": " << d.message;
+    a.current = lbs(a, pose2);
+    SkinnedMesh b = original;
+    b.current = lbs(original, pose2);
+    for (const TopologyChange& ch : d.changes) apply(b, ch);
+    ASSERT_EQ(a.vertex_count(), b.vertex_count());
+    EXPECT_EQ(a.faces, b.faces);
+    double worst_same = 0, worst_blend = 0;
+    for (std::int32_t v = 0; v < a.vertex_count(); ++v) {
+      const double err = (a.current.col(v) - b.current.col(v)).norm();
+      bool same = true;
+      if (v >= original.vertex_count()) {
+        const NewVertex& nv =
+            d.changes[0].new_vertices[static_cast<std::size_t>(v - original.vertex_count())];
+        for (int k = 1; k < 3; ++k)
+          if (nv.parents[k] >= 0 && (a.weights.col(nv.parents[k]) != a.weights.col(nv.parents[0]) ||
+                                     a.bones.col(nv.parents[k]) != a.bones.col(nv.parents[0])))
+            same = false;
+      }
+      (same ? worst_same : worst_blend) = std::max(same ? worst_same : worst_blend, err);
+    }
+    EXPECT_LT(worst_same, 1e-9) << "z " << z;
+    EXPECT_LT(worst_blend, 2e-3) << "z " << z;
+  }
 }

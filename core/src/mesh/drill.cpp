@@ -44,6 +44,9 @@ int edge_roots(const Eigen::Vector2d& mu, const Eigen::Vector2d& nu, double r2, 
   const Eigen::Vector2d d = nu - mu;
   const double k = d.squaredNorm(), l = 2 * mu.dot(d), n = mu.squaredNorm() - r2;
   if (!(k > 0)) return 0;  // the edge is parallel to the axis: its projection is a point
+  // Both ends outside and the closest point (α = −l / 2k) off the edge: no root in [0, 1]
+  // (the common case of the walk's neighbours, without a root or a division).
+  if (n > 0 && n + l + k > 0 && (l >= 0 || l + 2 * k <= 0)) return 0;
   const double disc = l * l - 4 * k * n;
   if (disc <= 0) return 0;  // misses, or tangent (a double root: touches without crossing)
   const double sq = std::sqrt(disc);
@@ -330,11 +333,12 @@ class Region {
   }
 
   // An edge comes within r of the axis: an end inside, or its projection's closest point.
+  // (Sides are the raw inside tests until the snapping of step 5.)
   bool edge_near(std::int32_t a, std::int32_t b) const {
-    const Eigen::Vector2d &mu = verts[std::size_t(a)].q, &nu = verts[std::size_t(b)].q;
-    if (inside(mu) || inside(nu)) return true;
+    const Vertex &va = verts[std::size_t(a)], &vb = verts[std::size_t(b)];
+    if (va.side < 0 || vb.side < 0) return true;
     double roots[2];
-    return edge_roots(mu, nu, axis_.r2, roots) == 2;
+    return edge_roots(va.q, vb.q, axis_.r2, roots) == 2;
   }
   bool face_near(std::int32_t g) {
     const Face& t = mesh_->faces[std::size_t(g)];
@@ -449,23 +453,6 @@ class Region {
            (s[0] <= 0 && s[1] <= 0 && s[2] <= 0 && s[0] + s[1] + s[2] < 0);
   }
 
-  // The rim (the cylinder's trace) crosses face f: a vertex on each side, an edge entering and
-  // leaving the disc, or the whole disc inside the pierced face.
-  bool crossed(std::int32_t f) const {
-    const LocalFace& t = faces[std::size_t(f)];
-    int in = 0;
-    for (int k = 0; k < 3; ++k) in += inside(verts[std::size_t(t.v[k])].q);
-    if (in == 3) return false;
-    if (in > 0) return true;
-    for (int k = 0; k < 3; ++k) {
-      double roots[2];
-      if (edge_roots(verts[std::size_t(t.v[k])].q, verts[std::size_t(t.v[(k + 1) % 3])].q, axis_.r2,
-                     roots) == 2)
-        return true;
-    }
-    return origins[std::size_t(t.origin)].seed && contains_axis(f);
-  }
-
   // How far apart (on Π) the rim's crossings of face f's edges are: the longest chord of the
   // rim polygon that f will hold; +∞ when the whole disc lies inside the pierced face f, 0
   // when the rim does not cross f.
@@ -474,13 +461,13 @@ class Region {
     Eigen::Vector2d points[6];
     int n = 0, in = 0;
     for (int k = 0; k < 3; ++k) {
-      const Eigen::Vector2d &mu = verts[std::size_t(t.v[k])].q,
-                            &nu = verts[std::size_t(t.v[(k + 1) % 3])].q;
-      in += inside(mu);
+      const Vertex &a = verts[std::size_t(t.v[k])], &b = verts[std::size_t(t.v[(k + 1) % 3])];
+      in += a.side < 0;
+      if (a.side < 0 && b.side < 0) continue;
       double roots[2];
-      const int count = edge_roots(mu, nu, axis_.r2, roots);
-      if (inside(mu) != inside(nu) || count == 2)
-        for (int i = 0; i < count; ++i) points[n++] = mu + roots[i] * (nu - mu);
+      const int count = edge_roots(a.q, b.q, axis_.r2, roots);
+      if (a.side != b.side || count == 2)
+        for (int i = 0; i < count; ++i) points[n++] = a.q + roots[i] * (b.q - a.q);
     }
     if (in == 3) return 0;
     if (n < 2)

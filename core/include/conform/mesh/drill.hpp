@@ -10,14 +10,15 @@
 //   3. the patch is copied out (with whatever neighbours step 4 reaches) and each of its edges
 //      is intersected with the cylinder by the quadratic of eqs 18–20 on its projection on Π
 //      (exact: the projection is affine); a tangent edge (double root) does not cross;
-//   4. refinement, only where the rim crosses: a face the rim crosses (a vertex on each side,
-//      an edge entering and leaving the disc, or the whole disc inside a pierced face) whose
-//      longest edge exceeds 1.5 × the circumference / min_rim_points is bisected (Rivara's
-//      longest-edge bisection: neighbours stay conforming, angles stay at least half the
-//      original's), and the limit halves while a patch has fewer than min_rim_points crossings.
-//      An edge that enters and leaves the disc between two outside vertices is then shorter
-//      than the limit and is left whole (the area it cuts off is below the inscribed polygon's
-//      own shortfall). Faces wholly inside or outside are not refined;
+//   4. refinement, only where the rim crosses: a face whose edges the rim crosses (a vertex on
+//      each side, an edge entering and leaving the disc, or the whole disc inside a pierced
+//      face) at points farther apart on Π than 1.2 × the circumference / min_rim_points (the
+//      rim polygon's chord it would hold) is bisected (Rivara's longest-edge bisection:
+//      neighbours stay conforming, angles stay at least half the original's), and the limit
+//      shrinks while a patch has fewer than min_rim_points crossings. An edge entering and
+//      leaving the disc between two outside vertices is then a chord within the limit and is
+//      left whole (the area it cuts off is at most an inscribed chord's shortfall). Faces the
+//      rim does not cross are not refined;
 //   5. the inside is removed and the rim re-triangulated (split triangles stay triangles).
 // Vertices closer to the cylinder than snap_fraction of an edge are taken as rim vertices (not
 // moved), so there are no slivers; the computed rim points lie on the cylinder to rounding.
