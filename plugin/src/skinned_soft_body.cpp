@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <ctime>
 #include <limits>
 #include <stdexcept>
@@ -113,6 +114,35 @@ void unlink_leaf(btDbvt& tree, btDbvtNode* leaf, std::vector<btDbvtNode*>& pool)
   else
     tree.m_root = sibling;
   pool.push_back(parent);
+}
+
+// btDbvt::insert without its walk down from the root: the new leaf becomes the sibling of
+// `beside` (a leaf of the same tree, e.g. a neighbouring node's), and the ancestors grow as
+// btDbvt's own insert grows them.
+btDbvtNode* insert_leaf_beside(btDbvt& tree, btDbvtNode* beside, const btDbvtVolume& volume,
+                               void* data) {
+  auto* leaf = new (btAlignedAlloc(sizeof(btDbvtNode), 16)) btDbvtNode();
+  leaf->volume = volume;
+  leaf->data = data;
+  leaf->childs[1] = nullptr;
+  auto* node = new (btAlignedAlloc(sizeof(btDbvtNode), 16)) btDbvtNode();
+  btDbvtNode* up = beside->parent;
+  node->parent = up;
+  Merge(volume, beside->volume, node->volume);
+  node->childs[0] = beside;
+  node->childs[1] = leaf;
+  beside->parent = node;
+  leaf->parent = node;
+  ++tree.m_leaves;
+  if (!up) {
+    tree.m_root = node;
+    return leaf;
+  }
+  up->childs[up->childs[1] == beside ? 1 : 0] = node;
+  for (btDbvtNode* child = node; up && !up->volume.Contain(child->volume);
+       child = up, up = up->parent)
+    Merge(up->childs[0]->volume, up->childs[1]->volume, up->volume);
+  return leaf;
 }
 
 // Recomputes every internal volume from its children (after many leaves were unlinked: one
@@ -381,7 +411,9 @@ void SkinnedSoftBody::set_node_mass(std::int32_t v) {
   const auto i = static_cast<std::size_t>(v);
   if (piece_of_[i] < 0) return;
   btSoftBody::Node& node = body_of(v)->m_nodes[node_of_[i]];
-  node.m_im = kinematic_[i] ? btScalar(0) : btScalar(1 / mass_[i]);
+  const btScalar im = kinematic_[i] ? btScalar(0) : btScalar(1 / mass_[i]);
+  if (im == node.m_im) return;  // e.g. a kinematic node: its links' constants stand
+  node.m_im = im;
   update_link_constants(v);
 }
 
@@ -415,10 +447,26 @@ void SkinnedSoftBody::update_node_area(std::int32_t v) {
 }
 
 void SkinnedSoftBody::add_node(std::int32_t p, std::int32_t v, const Eigen::Vector3d& x,
-                               const Eigen::Vector3d& vel) {
+                               const Eigen::Vector3d& vel, std::int32_t near) {
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
-  body.appendNode(to_btv(x), 1);
+  btDbvtNode* beside = near >= 0 && piece_of_[static_cast<std::size_t>(near)] == p
+                           ? body.m_nodes[node_of_[static_cast<std::size_t>(near)]].m_leaf
+                           : nullptr;
+  if (beside && body.m_nodes.size() < body.m_nodes.capacity()) {
+    // appendNode's node, with its tree leaf placed beside the leaf of a node next to it
+    // instead of by a walk down from the root (the array has room: nothing is re-pointed).
+    body.m_nodes.push_back(btSoftBody::Node());
+    btSoftBody::Node& node = body.m_nodes[body.m_nodes.size() - 1];
+    std::memset(static_cast<void*>(&node), 0, sizeof(node));
+    node.m_x = node.m_q = to_btv(x);
+    node.m_material = body.m_materials[0];
+    node.m_leaf = insert_leaf_beside(
+        body.m_ndbvt, beside, btDbvtVolume::FromCR(node.m_x, body.getCollisionShape()->getMargin()),
+        &node);
+  } else {
+    body.appendNode(to_btv(x), 1);
+  }
   btSoftBody::Node& node = body.m_nodes[body.m_nodes.size() - 1];
   node.m_v = to_btv(vel);
   const auto i = static_cast<std::size_t>(v);
@@ -1111,6 +1159,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
             if (w < v0) has_old[static_cast<std::size_t>(rs)] = 1;
             continue;
           }
+          if (label == s) continue;
           const std::int32_t rw = root_of(label);
           if (rw == rs) continue;
           const std::int32_t r = std::min(rw, rs), o = std::max(rw, rs);
@@ -1267,7 +1316,8 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       }
       p = o;
     }
-    add_node(p, id, nx[static_cast<std::size_t>(i)], nv[static_cast<std::size_t>(i)]);
+    add_node(p, id, nx[static_cast<std::size_t>(i)], nv[static_cast<std::size_t>(i)],
+             change.new_vertices[static_cast<std::size_t>(i)].parents[0]);
   }
   for (const auto& s : searches)
     for (const auto v : s.queue) search_label_[static_cast<std::size_t>(v)] = -1;

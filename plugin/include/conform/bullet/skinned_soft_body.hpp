@@ -214,8 +214,9 @@ class SkinnedSoftBody {
   void mirror(const mesh::TopologyChange& change);
   void rebuild_skin_inputs();
   void set_node_mass(std::int32_t vertex);
+  /// `near`: a vertex next to it whose tree leaf it joins (−1: Bullet's own insert).
   void add_node(std::int32_t piece, std::int32_t vertex, const Eigen::Vector3d& x,
-                const Eigen::Vector3d& v);
+                const Eigen::Vector3d& v, std::int32_t near = -1);
   void add_face(std::int32_t piece, std::int32_t face);
   void remove_face_from_bullet(std::int32_t face);
   void remove_face_slot(std::int32_t face);  // out of its body only (no links, no stats)
