@@ -453,6 +453,15 @@ class Region {
            (s[0] <= 0 && s[1] <= 0 && s[2] <= 0 && s[0] + s[1] + s[2] < 0);
   }
 
+  // The longest edge of face f on Π, squared: a bound on its rim extent (points on a triangle's
+  // edges are no farther apart than its longest edge), without roots.
+  double projected_diameter2(std::int32_t f) const {
+    const LocalFace& t = faces[std::size_t(f)];
+    const Eigen::Vector2d &a = verts[std::size_t(t.v[0])].q, &b = verts[std::size_t(t.v[1])].q,
+                          &c = verts[std::size_t(t.v[2])].q;
+    return std::max({(b - a).squaredNorm(), (c - b).squaredNorm(), (a - c).squaredNorm()});
+  }
+
   // How far apart (on Π) the rim's crossings of face f's edges are: the longest chord of the
   // rim polygon that f will hold; +∞ when the whole disc lies inside the pierced face f, 0
   // when the rim does not cross f.
@@ -675,7 +684,9 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
       const std::int32_t f = work.back();
       work.pop_back();
       const Region::LocalFace& lf = region.faces[std::size_t(f)];
-      if (lf.depth >= max_depth || region.rim_extent(f) <= patches[std::size_t(lf.patch)].limit)
+      const double limit = patches[std::size_t(lf.patch)].limit;
+      if (lf.depth >= max_depth || region.projected_diameter2(f) <= limit * limit ||
+          region.rim_extent(f) <= limit)
         continue;
       region.touched.clear();
       region.refine(f);
@@ -713,8 +724,10 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
         edge_roots(region.verts[std::size_t(a)].q, region.verts[std::size_t(b)].q, axis.r2, roots);
     return n > 0 ? roots[0] : 0.5;
   };
-  for (const auto& lf : region.faces)
+  for (std::size_t f = 0; f < region.faces.size(); ++f)
     for (int k = 0; k < 3; ++k) {
+      const Region::LocalFace& lf = region.faces[f];
+      if (lf.twin[k] >= 0 && lf.twin[k] < std::int32_t(3 * f) + k) continue;  // each edge once
       const std::int32_t a = std::min(lf.v[k], lf.v[(k + 1) % 3]),
                          b = std::max(lf.v[k], lf.v[(k + 1) % 3]);
       auto &va = region.verts[std::size_t(a)], &vb = region.verts[std::size_t(b)];
