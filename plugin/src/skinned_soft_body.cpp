@@ -893,6 +893,8 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   pinned_.resize(total, 0);
   kinematic_.resize(total, 0);
   vertex_faces_.resize(total);
+  for (std::size_t v = std::size_t(v0); v < total; ++v)
+    vertex_faces_[v].reserve(8);      // one allocation
   std::vector<std::int32_t> touched;  // old vertices whose mass changed
   auto pos = [&](std::int32_t p) {
     return p < v0 ? position(p) : nx[static_cast<std::size_t>(p - v0)];
@@ -1316,8 +1318,13 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       }
       p = o;
     }
-    add_node(p, id, nx[static_cast<std::size_t>(i)], nv[static_cast<std::size_t>(i)],
-             change.new_vertices[static_cast<std::size_t>(i)].parents[0]);
+    std::int32_t near = -1;  // a parent in the same body, whose tree leaf it joins
+    for (const auto q : change.new_vertices[static_cast<std::size_t>(i)].parents)
+      if (q >= 0 && piece_of_[static_cast<std::size_t>(q)] == p) {
+        near = q;
+        break;
+      }
+    add_node(p, id, nx[static_cast<std::size_t>(i)], nv[static_cast<std::size_t>(i)], near);
   }
   for (const auto& s : searches)
     for (const auto v : s.queue) search_label_[static_cast<std::size_t>(v)] = -1;
