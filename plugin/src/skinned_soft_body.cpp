@@ -1094,6 +1094,14 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     if (!vertex_faces_[static_cast<std::size_t>(seeds[i])].empty())
       boundary.push_back(std::int32_t(i));
   std::vector<std::int32_t> cluster_group(cluster.size(), -1);
+  // The proof needs each cluster in one group, so it is only tried with no more groups growing
+  // than there are clusters (a cut's single ring never: the search must end the other way).
+  std::int32_t clusters = 0;
+  for (const auto i : boundary) {
+    auto& g = cluster_group[static_cast<std::size_t>(cluster_root(i))];
+    if (g < 0) g = 0, ++clusters;
+  }
+  for (const auto i : boundary) cluster_group[static_cast<std::size_t>(cluster_root(i))] = -1;
   auto body_unbroken = [&]() {
     bool proven = true;
     for (const auto i : boundary) {
@@ -1113,7 +1121,8 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   };
   bool merged = false;
   while (!active.empty()) {
-    if (merged && one_body && !to_the_end && growing > 1 && body_unbroken()) {
+    if (merged && one_body && !to_the_end && growing > 1 && growing <= clusters &&
+        body_unbroken()) {
       // One group for the body: every group holding an old vertex.
       open_piece = only_piece;
       for (std::size_t s = 0; s < searches.size(); ++s) {
