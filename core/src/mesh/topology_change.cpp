@@ -164,6 +164,13 @@ void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adj
     mesh.faces[static_cast<std::size_t>(removed[k])] = added[k];
     if (adjacency) adjacency->add_face(mesh, removed[k]);
   }
+  if (added.size() > filled) {
+    // Grow the face array and the adjacency's half-edge array once, to their exact size,
+    // rather than by repeated doubling as faces are appended one by one.
+    const std::size_t grown = mesh.faces.size() + (added.size() - filled);
+    mesh.faces.reserve(grown);
+    if (adjacency) adjacency->resize_faces(static_cast<std::int32_t>(grown));
+  }
   for (std::size_t k = filled; k < added.size(); ++k) {
     mesh.faces.push_back(added[k]);
     if (adjacency) adjacency->add_face(mesh, mesh.face_count() - 1);
