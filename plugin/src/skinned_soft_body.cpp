@@ -853,7 +853,15 @@ std::int32_t SkinnedSoftBody::move_to_new_piece(std::span<const std::int32_t> mo
     if (node.m_leaf) unlink_leaf(old.m_ndbvt, node.m_leaf, pool);
     node.m_leaf = nullptr;
   }
-  remove_nodes_highest_first(moving);
+  // Out of the old bodies, highest node first (read off the marks, no sort): the last nodes of
+  // a body are popped without a swap.
+  for (const auto p : sources) {
+    const Piece& from = *pieces_[static_cast<std::size_t>(p)];
+    for (auto i = std::int32_t(from.node_vertex.size()); i-- > 0;)
+      if (i < std::int32_t(from.node_vertex.size()) &&
+          move_slot_[static_cast<std::size_t>(from.node_vertex[static_cast<std::size_t>(i)])] >= 0)
+        remove_node(from.node_vertex[static_cast<std::size_t>(i)]);
+  }
   for (const auto p : sources)
     refit_tree(pieces_[static_cast<std::size_t>(p)]->body->m_ndbvt.m_root);
   for (int i = 0; i < n; ++i) {
