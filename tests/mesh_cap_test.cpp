@@ -322,3 +322,107 @@ TEST(CapNested, PropertyRandomPlanes) {
     EXPECT_GT(nested, 60) << name(method);
   }
 }
+
+namespace {
+
+// Checks a section triangulation of `loops`: triangle count V + 2H − 2 per region (given),
+// every triangle counter-clockwise with a positive area, the areas adding up to `area`, and
+// the empty-circle property on every inner edge (constrained Delaunay). Returns the smallest
+// angle.
+double expect_cdt(const Loops& loops, const SectionTriangulation& s, std::size_t triangles,
+                  double area, const std::string& what) {
+  std::vector<Eigen::Vector2d> all;
+  for (const auto& l : loops) all.insert(all.end(), l.begin(), l.end());
+  auto P = [&](std::int32_t i) { return all[static_cast<std::size_t>(i)]; };
+  EXPECT_EQ(s.triangles.size(), triangles) << what;
+  double scale = 0;
+  for (const auto& q : all) scale = std::max(scale, q.cwiseAbs().maxCoeff());
+  double sum = 0, min_angle = M_PI;
+  for (const auto& t : s.triangles) {
+    const Eigen::Vector2d u = P(t[1]) - P(t[0]), w = P(t[2]) - P(t[0]);
+    const double a = 0.5 * (u.x() * w.y() - u.y() * w.x());
+    EXPECT_GT(a, 1e-12 * scale * scale) << what << ": a flat or clockwise triangle";
+    sum += a;
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector2d x = P(t[(k + 1) % 3]) - P(t[k]), y = P(t[(k + 2) % 3]) - P(t[k]);
+      min_angle = std::min(min_angle, std::acos(x.normalized().dot(y.normalized())));
+    }
+  }
+  EXPECT_NEAR(sum, area, 1e-12 * std::abs(area)) << what;
+  int violations = 0;
+  for (const auto& t : s.triangles)
+    for (const auto& o : s.triangles)
+      for (int k = 0; k < 3; ++k)
+        for (int j = 0; j < 3; ++j) {
+          if (t[k] != o[(j + 1) % 3] || t[(k + 1) % 3] != o[j]) continue;  // shared edge
+          const Eigen::Vector2d a = P(t[k]) - P(o[(j + 2) % 3]),
+                                b = P(t[(k + 1) % 3]) - P(o[(j + 2) % 3]),
+                                c = P(t[(k + 2) % 3]) - P(o[(j + 2) % 3]);
+          const double in = a.squaredNorm() * (b.x() * c.y() - b.y() * c.x()) -
+                            b.squaredNorm() * (a.x() * c.y() - a.y() * c.x()) +
+                            c.squaredNorm() * (a.x() * b.y() - a.y() * b.x());
+          violations += in > 1e-10 * std::pow(scale, 4);
+        }
+  EXPECT_EQ(violations, 0) << what;
+  return min_angle;
+}
+
+// A convex polygon through `corners` points of an ellipse, with `flat` points evenly spaced on
+// every edge (collinear with the edge's ends, as the crossings of split quads' diagonals are).
+std::vector<Eigen::Vector2d> ellipse_with_flat_points(int corners, int flat, double a, double b,
+                                                      Eigen::Vector2d centre) {
+  std::vector<Eigen::Vector2d> loop;
+  for (int i = 0; i < corners; ++i) {
+    const double t0 = 2 * M_PI * i / corners, t1 = 2 * M_PI * (i + 1) / corners;
+    const Eigen::Vector2d p0 = centre + Eigen::Vector2d(a * std::cos(t0), b * std::sin(t0)),
+                          p1 = centre + Eigen::Vector2d(a * std::cos(t1), b * std::sin(t1));
+    for (int j = 0; j <= flat; ++j) loop.push_back(p0 + (p1 - p0) * (double(j) / (flat + 1)));
+  }
+  return loop;
+}
+
+}  // namespace
+
+TEST(Section, ConvexLoopsWithAndWithoutFlatVertices) {
+  // A plain ellipse (the ear clipper's strip), an ellipse polygon with a point on every edge
+  // (the arm's sections), a square with many points per side (both loop edges of a triangle
+  // carry flat runs) and a symmetric ellipse (exactly cocircular quadruples), with both
+  // triangulators: constrained Delaunay, exact areas, V − 2 triangles, the same smallest angle.
+  const std::vector<std::pair<std::string, Loops>> cases = {
+      {"ellipse", {ellipse_with_flat_points(64, 0, 0.04, 0.03, {0.01, 0.2})}},
+      {"ellipse with midpoints", {ellipse_with_flat_points(32, 1, 0.04, 0.038, {-0.3, 0.07})}},
+      {"square with runs", {ellipse_with_flat_points(4, 6, 1.0, 1.0, {2.0, -1.0})}},
+      {"near circle with runs", {ellipse_with_flat_points(20, 3, 0.5, 0.5001, {0, 0})}},
+  };
+  for (const auto& [what, loops] : cases) {
+    const double area = std::abs(polygon_area(loops[0]));
+    double angle[2] = {-1, -1};
+    for (const auto method : triangulators()) {
+      const SectionTriangulation s = triangulate_section(loops, method);
+      ASSERT_TRUE(s.ok()) << what << ", " << name(method) << ": " << s.problem;
+      EXPECT_EQ(s.depth, std::vector<std::int32_t>{0});
+      angle[method == SectionTriangulator::EarClipping ? 0 : 1] =
+          expect_cdt(loops, s, loops[0].size() - 2, area, what + ", " + name(method));
+    }
+    if (angle[1] >= 0) {
+      EXPECT_NEAR(angle[0], angle[1], 1e-9) << what;
+    }
+  }
+}
+
+TEST(Section, FlatVerticesOnHolesAndIslands) {
+  // Runs of collinear points on an outer loop, on a hole and on an island in the hole.
+  Loops loops = {ellipse_with_flat_points(16, 2, 4, 3, {0, 0}),
+                 ellipse_with_flat_points(8, 3, 2, 1.5, {0.3, 0}),
+                 ellipse_with_flat_points(6, 1, 0.5, 0.4, {0.4, 0.1})};
+  std::reverse(loops[1].begin(), loops[1].end());
+  const double area = std::abs(polygon_area(loops[0])) - std::abs(polygon_area(loops[1])) +
+                      std::abs(polygon_area(loops[2]));
+  const std::size_t triangles = loops[0].size() + loops[1].size() + 2 - 2 + loops[2].size() - 2;
+  for (const auto method : triangulators()) {
+    const SectionTriangulation s = triangulate_section(loops, method);
+    ASSERT_TRUE(s.ok()) << name(method) << ": " << s.problem;
+    EXPECT_EQ(s.depth, (std::vector<std::int32_t>{0, 1, 2})) << name(method);
+    expect_cdt(loops, s, triangles, area, name(method));
+  }
+}
