@@ -1168,30 +1168,34 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       auto& search = searches[static_cast<std::size_t>(s)];
       const std::int32_t u = search.queue[search.head++];
       std::int32_t rs = root_of(s);
-      for (const auto f : vertex_faces_[static_cast<std::size_t>(u)])
-        for (const auto w : faces_[static_cast<std::size_t>(f)]) {
-          std::int32_t& label = search_label_[static_cast<std::size_t>(w)];
-          if (label < 0) {
-            label = s;
-            auto& grow = searches[static_cast<std::size_t>(s)];
-            grow.queue.push_back(w);
-            if (w < v0) has_old[static_cast<std::size_t>(rs)] = 1;
-            continue;
-          }
-          if (label == s) continue;
-          const std::int32_t rw = root_of(label);
-          if (rw == rs) continue;
-          const std::int32_t r = std::min(rw, rs), o = std::max(rw, rs);
-          merged = true;
-          has_old[static_cast<std::size_t>(r)] |= has_old[static_cast<std::size_t>(o)];
-          auto& pr = pending_in[static_cast<std::size_t>(r)];
-          auto& po = pending_in[static_cast<std::size_t>(o)];
-          if (pr > 0 && po > 0) --growing;
-          pr += po;
-          po = 0;
-          searches[static_cast<std::size_t>(o)].root = r;
-          rs = r;
+      // Only the vertex after u in each of its faces: a face's vertices form a cycle under
+      // "next", so its others are reached (and any other group labelling one of them is met)
+      // from there, a third of the look-ups of all three.
+      for (const auto f : vertex_faces_[static_cast<std::size_t>(u)]) {
+        const auto& tri = faces_[static_cast<std::size_t>(f)];
+        const std::int32_t w = tri[0] == u ? tri[1] : tri[1] == u ? tri[2] : tri[0];
+        std::int32_t& label = search_label_[static_cast<std::size_t>(w)];
+        if (label < 0) {
+          label = s;
+          auto& grow = searches[static_cast<std::size_t>(s)];
+          grow.queue.push_back(w);
+          if (w < v0) has_old[static_cast<std::size_t>(rs)] = 1;
+          continue;
         }
+        if (label == s) continue;
+        const std::int32_t rw = root_of(label);
+        if (rw == rs) continue;
+        const std::int32_t r = std::min(rw, rs), o = std::max(rw, rs);
+        merged = true;
+        has_old[static_cast<std::size_t>(r)] |= has_old[static_cast<std::size_t>(o)];
+        auto& pr = pending_in[static_cast<std::size_t>(r)];
+        auto& po = pending_in[static_cast<std::size_t>(o)];
+        if (pr > 0 && po > 0) --growing;
+        pr += po;
+        po = 0;
+        searches[static_cast<std::size_t>(o)].root = r;
+        rs = r;
+      }
       if (searches[static_cast<std::size_t>(s)].head <
           searches[static_cast<std::size_t>(s)].queue.size())
         active[kept++] = s;
