@@ -163,12 +163,33 @@ double inside_length(const SkinnedMesh& m, const DrillTool& tool) {
 // A drill with the tube wall through both walls of a closed mesh: closed, manifold, oriented,
 // and the volume lost is the drilled prism's. Returns the relative volume error against
 // π r² L (L: the axis' length inside the mesh).
-double expect_tube(const SkinnedMesh& in, const DrillTool& tool, const std::string& what) {
+// The median and worst aspect (longest edge squared over twice the area: the longest edge
+// over its altitude) of the last `count` faces.
+std::pair<double, double> aspects(const SkinnedMesh& m, std::int32_t count) {
+  std::vector<double> all;
+  for (std::int32_t f = m.face_count() - count; f < m.face_count(); ++f) {
+    const Face& t = m.faces[static_cast<std::size_t>(f)];
+    double longest = 0;
+    for (int k = 0; k < 3; ++k)
+      longest = std::max(longest, (m.current.col(t[(k + 1) % 3]) - m.current.col(t[k])).norm());
+    const double area2 = (m.current.col(t[1]) - m.current.col(t[0]))
+                             .cross(m.current.col(t[2]) - m.current.col(t[0]))
+                             .norm();
+    all.push_back(longest * longest / area2);
+  }
+  if (all.empty()) return {0, 0};
+  std::sort(all.begin(), all.end());
+  return {all[all.size() / 2], all.back()};
+}
+
+double expect_tube(const SkinnedMesh& in, const DrillTool& tool, const std::string& what,
+                   double ring_spacing = 0, std::pair<double, double>* aspect = nullptr) {
   SkinnedMesh m = in;
   Adjacency adj(m);
   FaceIndex index(m);
   DrillOptions options;
   options.tube = true;
+  options.tube_ring_spacing = ring_spacing;
   const DrillResult d = drill(m, adj, index, tool, options);
   EXPECT_EQ(d.holes, 2) << what << ": " << d.message;
   EXPECT_EQ(d.tubes, 1) << what << ": " << d.message;
@@ -189,6 +210,7 @@ double expect_tube(const SkinnedMesh& in, const DrillTool& tool, const std::stri
   EXPECT_GE(on, d.rim_vertices) << what;
   // The index was kept in sync through refinements, holes and tube.
   EXPECT_EQ(index.validate(m), "") << what;
+  if (aspect) *aspect = aspects(m, d.tube_faces);  // the tube's faces come last
   const double lost = signed_volume(in) - signed_volume(m);
   const double prism = std::numbers::pi * tool.radius * tool.radius * inside_length(in, tool);
   return (lost - prism) / prism;
@@ -264,8 +286,8 @@ TEST(Drill, IndexScanAndNoIndexAgree) {
 }
 
 TEST(Drill, PropertyRandomTubesThroughTheArm) {
-  // Random drills right through the arm with the tube: whenever a tube is made the arm is
-  // closed, manifold and oriented again, and it loses volume.
+  // Random drills right through the arm with the tube (half with rings): whenever a tube is
+  // made the arm is closed, manifold and oriented again, and it loses volume.
   const SkinnedMesh arm = make_arm(1).mesh;
   const double v0 = signed_volume(arm);
   std::mt19937 rng(78);
@@ -282,6 +304,7 @@ TEST(Drill, PropertyRandomTubesThroughTheArm) {
     const double r = 0.004 + 0.01 * u(rng);
     DrillOptions o;
     o.tube = true;
+    o.tube_ring_spacing = trial % 2 ? 2.0 : 0.0;  // half of them with rings
     const DrillResult d = drill(m, adj, index, {c - 0.2 * dir, c + 0.2 * dir, r}, o);
     tubes += d.tubes;
     const MeshReport rep = check_mesh(m, 1e-14 * std::pow(bounding_diagonal(m), 2));
@@ -508,5 +531,35 @@ TEST(Drill, ReDeformation) {
     }
     EXPECT_LT(worst_same, 1e-9) << "z " << z;
     EXPECT_LT(worst_blend, 2e-3) << "z " << z;
+  }
+}
+
+TEST(Drill, TubeRings) {
+  // Intermediate rings: the tube stays closed, manifold and oriented, loses the prism's volume
+  // as without rings, and its triangles are no longer one-per-wall needles: the median aspect
+  // (longest edge over its altitude) drops from about the wall's length over the rim spacing
+  // to a few, the worst (set by the rims' shortest edges, which rings cannot widen) tenfold.
+  const SkinnedMesh arm = make_arm(1).mesh;
+  const SkinnedMesh sphere = make_icosphere(4);
+  struct Case {
+    const SkinnedMesh& mesh;
+    DrillTool tool;
+    const char* what;
+  } cases[] = {{arm, {{0, -0.2, 0.42}, {0, 0.2, 0.42}, 0.01}, "forearm"},
+               {arm, {{-0.2, 0.03, 0.17}, {0.2, -0.03, 0.15}, 0.012}, "upper arm"},
+               {sphere, {{0.1, 0.05, 2}, {0.1, 0.05, -2}, 0.2}, "sphere"}};
+  for (const Case& c : cases) {
+    std::pair<double, double> plain, ringed;
+    const double e0 = expect_tube(c.mesh, c.tool, c.what, 0, &plain);
+    const double e1 = expect_tube(c.mesh, c.tool, std::string(c.what) + " rings", 2, &ringed);
+    EXPECT_LT(std::abs(e1), 0.03) << c.what;
+    EXPECT_NEAR(e1, e0, 0.01) << c.what;
+    EXPECT_LT(ringed.first, 4) << c.what << " (without rings " << plain.first << ")";
+    EXPECT_LT(ringed.first, plain.first / 4) << c.what;
+    EXPECT_LT(ringed.second, plain.second / 10) << c.what;
+    RecordProperty(std::string("aspect_") + c.what, "median " + std::to_string(plain.first) +
+                                                        " -> " + std::to_string(ringed.first) +
+                                                        ", worst " + std::to_string(plain.second) +
+                                                        " -> " + std::to_string(ringed.second));
   }
 }

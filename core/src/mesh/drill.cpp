@@ -518,23 +518,29 @@ class Region {
 };
 
 // Joins consecutive holes along the axis, where the drill enters then leaves the surface, with
-// a strip of triangles between their rim loops (see drill.hpp, step 6).
+// a strip of triangles between their rim loops (see drill.hpp, step 6), through `rings`
+// intermediate rings when ring_spacing > 0.
 template <class Commit>
 void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis& axis,
-                const std::vector<Patch>& patches, DrillResult& result, Commit& commit) {
+                const std::vector<Patch>& patches, double ring_spacing, DrillResult& result,
+                Commit& commit) {
   std::vector<const Patch*> cut;
   for (const auto& p : patches)
     if (p.cut) cut.push_back(&p);
   std::sort(cut.begin(), cut.end(), [](const Patch* a, const Patch* b) { return a->t < b->t; });
-  // An orthonormal frame about the axis, for the rim vertices' angles.
-  int k0 = 0;
-  for (int k = 1; k < 3; ++k)
-    if (std::abs(axis.u[k]) < std::abs(axis.u[k0])) k0 = k;
-  const Eigen::Vector3d e1 = Eigen::Vector3d::Unit(k0).cross(axis.u).normalized();
-  const Eigen::Vector3d e2 = axis.u.cross(e1);
+  // Ring vertices (not in the mesh yet): (1 − s) a + s b of two rim vertices.
+  std::int32_t nv = mesh.vertex_count();  // the mesh's, as each tube is made
+  std::vector<NewVertex> ring_vertices;
+  auto pos = [&](std::int32_t v) -> Eigen::Vector3d {
+    if (v < nv) return mesh.current.col(v);
+    const NewVertex& r = ring_vertices[std::size_t(v - nv)];
+    return r.coefficients[0] * mesh.current.col(r.parents[0]) +
+           r.coefficients[1] * mesh.current.col(r.parents[1]);
+  };
+  // The rim vertices' angles about the axis, in the frame of Π.
   auto angle = [&](std::int32_t v) {
-    const Eigen::Vector3d r = axis.radial(mesh.current.col(v));
-    return std::atan2(r.dot(e2), r.dot(e1));
+    const Eigen::Vector2d q = axis.project(pos(v));
+    return std::atan2(q.y(), q.x());
   };
   constexpr double pi = std::numbers::pi;
   auto wrap = [](double a) { return std::remainder(a, 2 * pi); };
@@ -545,9 +551,31 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
       cum[k + 1] = cum[k] + wrap(angle(loop[(k + 1) % loop.size()]) - angle(loop[k]));
     return cum;
   };
+  // Both loops wind once about the axis the same way.
+  auto winds_with = [&](const std::vector<double>& a, const std::vector<double>& b) {
+    return std::abs(std::abs(a.back()) - 2 * pi) <= 1e-6 && std::abs(a.back() - b.back()) <= 1e-6;
+  };
   auto fail = [&](const std::string& why) {
     if (!result.message.empty()) result.message += "; ";
     result.message += why;
+  };
+  // The strip between loops P and Q (Q[0] the nearest of Q to P[0] in angle), merged by angle.
+  auto zip = [&](const std::vector<std::int32_t>& P, const std::vector<std::int32_t>& Q,
+                 std::vector<Face>& faces) {
+    const std::vector<double> alpha = turning(P), beta = turning(Q);
+    const double sign = alpha.back() > 0 ? 1 : -1, delta = wrap(angle(Q[0]) - angle(P[0]));
+    const std::size_t n = P.size(), m = Q.size();
+    for (std::size_t ia = 0, jb = 0; ia < n || jb < m;) {
+      const bool along_p =
+          jb == m || (ia < n && sign * alpha[ia + 1] <= sign * (delta + beta[jb + 1]));
+      if (along_p) {
+        faces.push_back({P[ia], P[(ia + 1) % n], Q[jb % m]});
+        ++ia;
+      } else {
+        faces.push_back({Q[(jb + 1) % m], Q[jb], P[ia % n]});
+        ++jb;
+      }
+    }
   };
   for (std::size_t i = 0; i + 1 < cut.size();) {
     const Patch& pa = *cut[i];
@@ -557,6 +585,8 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
       continue;
     }
     i += 2;
+    nv = mesh.vertex_count();
+    ring_vertices.clear();
     if (pa.rim.empty() || pb.rim.empty()) {
       fail("tube: a rim is not one simple loop of rim vertices");
       continue;
@@ -571,28 +601,65 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
     std::vector<std::int32_t> B(pb.rim.begin() + static_cast<std::ptrdiff_t>(j0), pb.rim.end());
     B.insert(B.end(), pb.rim.begin(), pb.rim.begin() + static_cast<std::ptrdiff_t>(j0));
     const std::vector<double> alpha = turning(A), beta = turning(B);
-    const double ta = alpha.back(), tb = beta.back();
-    if (std::abs(std::abs(ta) - 2 * pi) > 1e-6 || std::abs(ta - tb) > 1e-6) {
+    if (!winds_with(alpha, beta)) {
       fail("tube: the rims do not wind once around the axis in matching directions");
       continue;
     }
-    const double sign = ta > 0 ? 1 : -1, delta = wrap(angle(B[0]) - a0);
+    // Rings: each rim vertex's partner on the other rim is the one nearest in turning; ring k
+    // of K lies at s = k / (K + 1) on the segments from the nearer rim's vertices to their
+    // partners, so that it has that rim's spacing. K makes the rings at most ring_spacing ×
+    // the rims' mean edge apart (without them one triangle spans the whole wall).
+    const double sign = alpha.back() > 0 ? 1 : -1, delta = wrap(angle(B[0]) - a0);
     const std::size_t n = A.size(), m = B.size();
-    std::vector<Face> faces;
-    faces.reserve(n + m);
-    for (std::size_t ia = 0, jb = 0; ia < n || jb < m;) {
-      const bool along_a =
-          jb == m || (ia < n && sign * alpha[ia + 1] <= sign * (delta + beta[jb + 1]));
-      if (along_a) {
-        faces.push_back({A[ia], A[(ia + 1) % n], B[jb % m]});
-        ++ia;
-      } else {
-        faces.push_back({B[(jb + 1) % m], B[jb], A[ia % n]});
-        ++jb;
+    std::vector<std::vector<std::int32_t>> loops{A};
+    if (ring_spacing > 0) {
+      std::vector<std::size_t> partner_a(n), partner_b(m);
+      for (std::size_t ia = 0, jb = 0; ia < n; ++ia) {
+        while (jb + 1 < m && std::abs(sign * (delta + beta[jb + 1]) - sign * alpha[ia]) <
+                                 std::abs(sign * (delta + beta[jb]) - sign * alpha[ia]))
+          ++jb;
+        partner_a[ia] = jb;
+      }
+      for (std::size_t jb = 0, ia = 0; jb < m; ++jb) {
+        while (ia + 1 < n && std::abs(sign * alpha[ia + 1] - sign * (delta + beta[jb])) <
+                                 std::abs(sign * alpha[ia] - sign * (delta + beta[jb])))
+          ++ia;
+        partner_b[jb] = ia;
+      }
+      double rims = 0, across = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        rims += (pos(A[(k + 1) % n]) - pos(A[k])).norm();
+        across += (pos(B[partner_a[k]]) - pos(A[k])).norm() / double(n);
+      }
+      for (std::size_t k = 0; k < m; ++k) rims += (pos(B[(k + 1) % m]) - pos(B[k])).norm();
+      const double step = ring_spacing * rims / double(n + m);
+      const int rings = std::min(64, std::max(0, int(std::ceil(across / step)) - 1));
+      for (int r = 1; r <= rings; ++r) {
+        const double s = double(r) / (rings + 1);
+        std::vector<std::int32_t> ring;
+        if (s <= 0.5)
+          for (std::size_t k = 0; k < n; ++k) {
+            ring.push_back(nv + std::int32_t(ring_vertices.size()));
+            ring_vertices.push_back(NewVertex::on_edge(A[k], B[partner_a[k]], s));
+          }
+        else
+          for (std::size_t k = 0; k < m; ++k) {
+            ring.push_back(nv + std::int32_t(ring_vertices.size()));
+            ring_vertices.push_back(NewVertex::on_edge(A[partner_b[k]], B[k], s));
+          }
+        if (!winds_with(alpha, turning(ring))) {  // a ring folds back: no rings for this tube
+          ring_vertices.clear();
+          loops.resize(1);
+          break;
+        }
+        loops.push_back(std::move(ring));
       }
     }
+    loops.push_back(B);
+    std::vector<Face> faces;
+    for (std::size_t k = 0; k + 1 < loops.size(); ++k) zip(loops[k], loops[k + 1], faces);
     // The strip must only add edges: along the rims the reverse of a boundary half-edge, across
-    // the tube edges that do not exist yet.
+    // the tube edges that do not exist yet (ring vertices are new: no edge has them).
     EdgeMap in_a;
     for (auto v : A) in_a.insert(0, v, 1);
     bool ok = true;
@@ -608,8 +675,9 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
       continue;
     }
     TopologyChange tube;
-    tube.base_vertex_count = mesh.vertex_count();
+    tube.base_vertex_count = nv;
     tube.base_face_count = mesh.face_count();
+    tube.new_vertices = std::move(ring_vertices);
     tube.added_faces = std::move(faces);
     result.tube_faces += static_cast<std::int32_t>(tube.added_faces.size());
     ++result.tubes;
@@ -889,7 +957,8 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     }
 
   commit(std::move(ch));
-  if (options.tube) join_holes(mesh, adjacency, axis, patches, result, commit);
+  if (options.tube)
+    join_holes(mesh, adjacency, axis, patches, options.tube_ring_spacing, result, commit);
   return result;
 }
 

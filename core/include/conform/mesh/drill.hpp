@@ -31,7 +31,10 @@
 //      the two rim loops are stitched by a strip of triangles that walks both loops by angle
 //      around the axis (no new vertices: the tube's corners are the rim vertices), oriented as
 //      the surface, so that a closed input stays closed. A pair whose rims are not two simple
-//      loops winding once around the axis is left open (see message).
+//      loops winding once around the axis is left open (see message). With
+//      tube_ring_spacing > 0, intermediate rings of new vertices (each on the segment from a
+//      rim vertex to its partner, the other rim's vertex nearest in angle) split the wall so
+//      that its triangles are about as long as wide instead of spanning the whole wall.
 // Given a FaceIndex, the drill refits it first if it was marked moved and updates it for every
 // change it applies. Without one, it scans every face once (O(F), cheaper than building an
 // index for one query): keep an index for haptic rates (see face_index.hpp for who refits when).
@@ -63,6 +66,10 @@ struct DrillOptions {
   int max_refinements = 6;  // at most 2 × this many bisections of an original face
   double snap_fraction = 0.01;
   bool tube = false;  // join entry and exit holes of a closed surface with a tube wall
+  // With the tube: intermediate rings at most this many times the rims' mean edge length
+  // apart (0: none, one triangle spans the wall). Ring vertices are new vertices on the
+  // segments between the two rims (NewVertex::on_edge of rim vertices).
+  double tube_ring_spacing = 0;
   FaceSearch search = FaceSearch::Index;
 };
 
