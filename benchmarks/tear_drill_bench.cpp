@@ -79,10 +79,11 @@ struct Work {
     o.search = mode == 1 ? FaceSearch::Scan : FaceSearch::Index;
     return mode == 0 ? Tear(mesh, adjacency, index, o) : Tear(mesh, adjacency, o);
   }
-  DrillResult drill(int mode, const DrillTool& tool, bool tube) {
+  DrillResult drill(int mode, const DrillTool& tool, bool tube, double rings = 0) {
     DrillOptions o;
     o.search = mode == 1 ? FaceSearch::Scan : FaceSearch::Index;
     o.tube = tube;
+    o.tube_ring_spacing = rings;
     return mode == 0 ? conform::mesh::drill(mesh, adjacency, index, tool, o)
                      : conform::mesh::drill(mesh, adjacency, tool, o);
   }
@@ -122,18 +123,21 @@ void tear100(benchmark::State& state, int faces, int mode) {
   speedup(state, kPaperTearSeconds, total);
 }
 
-// Drill through the forearm (both walls), radius 1 cm, with or without the tube wall.
+// Drill through the forearm (both walls), radius 1 cm, with or without the tube wall (with
+// intermediate rings at most twice the rim spacing apart: `rings` 2).
 const DrillTool kDrill{{0, -0.2, 0.42}, {0, 0.2, 0.42}, 0.01};
-void drill_bench(benchmark::State& state, int faces, int mode, bool tube) {
+void drill_bench(benchmark::State& state, int faces, int mode, bool tube, double rings = 0) {
   const Model& m = model(faces);
   DrillResult r;
   double total = 0;
   for (auto _ : state) {
     Work w(m);
-    total += timed(state, [&] { r = w.drill(mode, kDrill, tube); });
+    total += timed(state, [&] { r = w.drill(mode, kDrill, tube, rings); });
   }
   state.counters["holes"] = r.holes;
   state.counters["tubes"] = r.tubes;
+  state.counters["tube_faces"] = r.tube_faces;
+  state.counters["changes"] = static_cast<double>(r.changes.size());
   state.counters["rim_points"] = r.rim_vertices;
   state.counters["refinements"] = r.refinements;
   state.counters["faces"] = static_cast<double>(m.mesh.face_count());
@@ -208,13 +212,17 @@ void register_all() {
           ->UseManualTime()
           ->Unit(benchmark::kMillisecond)
           ->Iterations(faces >= 500000 ? 3 : 10);
-      for (bool tube : {false, true})
-        benchmark::RegisterBenchmark(
-            ((tube ? "BM_DrillTube" : "BM_Drill") + tail).c_str(),
-            [=](benchmark::State& s) { drill_bench(s, faces, mode, tube); })
+      for (int variant = 0; variant < 3; ++variant) {
+        const char* name[] = {"BM_Drill", "BM_DrillTube", "BM_DrillTubeRings"};
+        benchmark::RegisterBenchmark((name[variant] + tail).c_str(),
+                                     [=](benchmark::State& s) {
+                                       drill_bench(s, faces, mode, variant > 0,
+                                                   variant == 2 ? 2.0 : 0.0);
+                                     })
             ->UseManualTime()
             ->Unit(benchmark::kMillisecond)
             ->Iterations(it);
+      }
     }
     benchmark::RegisterBenchmark(("BM_IndexBuild" + size).c_str(),
                                  [=](benchmark::State& s) { index_build(s, faces); })
