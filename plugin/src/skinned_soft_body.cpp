@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <ctime>
 #include <limits>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -40,6 +42,12 @@ void erase_value(std::vector<std::int32_t>& list, std::int32_t value) {
 }  // namespace
 
 struct SkinnedSoftBody::Piece {
+  // Memory the body's node, face and link arrays start in (see move_to_new_piece); declared
+  // first, so it outlives the body (which never frees memory it does not own).
+  struct Release {
+    void operator()(std::byte* p) const { ::operator delete[](p, std::align_val_t{16}); }
+  };
+  std::unique_ptr<std::byte[], Release> storage;
   std::unique_ptr<btSoftBody> body;
   std::vector<std::int32_t> node_vertex;  // node index → mesh vertex
   std::vector<double> rest;               // link index → our rest length (Bullet resets its own)
@@ -782,9 +790,21 @@ std::int32_t SkinnedSoftBody::move_to_new_piece(std::span<const std::int32_t> mo
   // zeroes every block it hands out (twice), so headroom is not free.
   const int node_room = n + joining + 16, face_room = int(faces.size()) + added_faces + 16,
             link_room = int(link_count) + 3 * added_faces * (bending ? 2 : 1) + 16;
-  body.m_nodes.reserve(node_room);
-  body.m_faces.reserve(face_room);
-  body.m_links.reserve(link_room);
+  {
+    // The arrays start in one block of our own: Bullet's allocator zeroes every block it hands
+    // out, twice, and these are filled at once. Were they to grow later, Bullet moves them to
+    // memory of its own and leaves this block alone.
+    auto round = [](std::size_t bytes) { return (bytes + 15) / 16 * 16; };
+    const std::size_t node_bytes = round(std::size_t(node_room) * sizeof(btSoftBody::Node)),
+                      face_bytes = round(std::size_t(face_room) * sizeof(btSoftBody::Face)),
+                      link_bytes = round(std::size_t(link_room) * sizeof(btSoftBody::Link));
+    into.storage.reset(static_cast<std::byte*>(
+        ::operator new[](node_bytes + face_bytes + link_bytes, std::align_val_t{16})));
+    std::byte* at = into.storage.get();
+    body.m_nodes.initializeFromBuffer(at, 0, node_room);
+    body.m_faces.initializeFromBuffer(at + node_bytes, 0, face_room);
+    body.m_links.initializeFromBuffer(at + node_bytes + face_bytes, 0, link_room);
+  }
   into.node_vertex.reserve(std::size_t(node_room));
   into.face_id.reserve(std::size_t(face_room));
   into.rest.reserve(std::size_t(link_room));
