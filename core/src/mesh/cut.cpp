@@ -66,17 +66,35 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   const std::int32_t nf0 = mesh.face_count();
   if (mesh.current.cols() != nv0)
     throw std::invalid_argument("cut: the current positions must be finite, one per vertex");
-  // One pass over the positions: finite, and their bounding box (the tolerance's scale).
-  double diagonal = 0;
+  // One pass over the positions: finite, their bounding box (the tolerance's scale), step 1's
+  // signed distances (the same predicates as classify_vertices) and the farthest vertex on
+  // each side.
+  std::vector<double> dist(static_cast<std::size_t>(nv0));
+  double diagonal = 0, reach_pos = 0, reach_neg = 0;
   if (nv0 > 0) {
     const double* x = mesh.current.data();
     double lo[3] = {x[0], x[1], x[2]}, hi[3] = {x[0], x[1], x[2]};
     bool finite = true;
-    for (std::int32_t i = 0; i < nv0; ++i, x += 3)
-      for (int k = 0; k < 3; ++k) {
-        finite &= std::isfinite(x[k]);
-        lo[k] = std::min(lo[k], x[k]), hi[k] = std::max(hi[k], x[k]);
+    auto pass = [&](auto distance) {
+      for (std::int32_t i = 0; i < nv0; ++i, x += 3) {
+        for (int k = 0; k < 3; ++k) {
+          finite &= std::isfinite(x[k]);
+          lo[k] = std::min(lo[k], x[k]), hi[k] = std::max(hi[k], x[k]);
+        }
+        const double s = distance(x);
+        dist[static_cast<std::size_t>(i)] = s;
+        reach_pos = std::max(reach_pos, s), reach_neg = std::max(reach_neg, -s);
       }
+    };
+    if (options.predicates == Predicates::Cga) {
+      pass([&](const double* p) {
+        return dot(cga::Point<double>::up(Eigen::Vector3d(p[0], p[1], p[2])), plane);
+      });
+    } else {
+      const Eigen::Vector3d n = plane.normal();
+      const double d = plane.distance();
+      pass([&](const double* p) { return n.x() * p[0] + n.y() * p[1] + n.z() * p[2] - d; });
+    }
     if (!finite)
       throw std::invalid_argument("cut: the current positions must be finite, one per vertex");
     diagonal = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
@@ -87,16 +105,7 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   result.change.base_face_count = nf0;
   if (nf0 == 0) return result;
 
-  std::vector<double> dist;
-  classify_vertices(mesh, plane, options.predicates, dist);
   const double eps = options.plane_tolerance * diagonal;
-  std::vector<std::int8_t> side(static_cast<std::size_t>(nv0));
-  double reach_pos = 0, reach_neg = 0;  // the farthest vertex on each side
-  for (std::int32_t i = 0; i < nv0; ++i) {
-    const double s = dist[static_cast<std::size_t>(i)];
-    side[static_cast<std::size_t>(i)] = s > eps ? 1 : (s < -eps ? -1 : 0);
-    reach_pos = std::max(reach_pos, s), reach_neg = std::max(reach_neg, -s);
-  }
   if (!(reach_pos > eps) || !(reach_neg > eps)) {
     // Every vertex on one side or on the plane: only faces lying in the plane could separate,
     // and they go to the side of the material (opposite their normal), i.e. the same side.
@@ -110,10 +119,12 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   const double snap = options.snap_fraction;
   const double k_snap = snap / (1 - snap) * (1 + 1e-9);  // a margin for rounding
   const double near_pos = k_snap * reach_neg, near_neg = k_snap * reach_pos;
+  std::vector<std::int8_t> side(static_cast<std::size_t>(nv0));
   std::vector<std::uint8_t> code(static_cast<std::size_t>(nv0));
   for (std::int32_t i = 0; i < nv0; ++i) {
     const double s = dist[static_cast<std::size_t>(i)];
-    const std::int8_t si = side[static_cast<std::size_t>(i)];
+    const std::int8_t si = s > eps ? 1 : (s < -eps ? -1 : 0);
+    side[static_cast<std::size_t>(i)] = si;
     code[static_cast<std::size_t>(i)] =
         static_cast<std::uint8_t>((si == 0  ? 1
                                    : si > 0 ? 2
