@@ -1048,14 +1048,18 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     face_piece_.pop_back();
     face_slot_.pop_back();
   }
-  for (const auto f : pending) {
-    const auto& tri = faces_[static_cast<std::size_t>(f)];
+  // Per pending face, a bit per edge that no face used until now: only such an edge lacks a
+  // link (an edge that kept a face kept its link), so only these are looked up again below.
+  std::vector<std::uint8_t> new_edges(pending.size(), 0);
+  for (std::size_t i = 0; i < pending.size(); ++i) {
+    const auto& tri = faces_[static_cast<std::size_t>(pending[i])];
     for (int k = 0; k < 3; ++k) {
-      vertex_faces_[static_cast<std::size_t>(tri[k])].push_back(f);
+      vertex_faces_[static_cast<std::size_t>(tri[k])].push_back(pending[i]);
       seed(tri[k]);
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
       const std::int32_t c = edge_faces_.find(a, b);
       edge_faces_.insert(a, b, c < 0 ? 1 : c + 1, true);
+      if (c < 0) new_edges[i] |= std::uint8_t(1u << k);
     }
   }
   stats_.added_faces += std::int32_t(pending.size());
@@ -1388,7 +1392,8 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       const auto& tri = faces_[static_cast<std::size_t>(f)];
       for (int k = 0; k < 3; ++k) bend_dirty_.push_back(edge_key(tri[k], tri[(k + 1) % 3]));
     }
-  for (const auto f : pending) {
+  for (std::size_t i = 0; i < pending.size(); ++i) {
+    const std::int32_t f = pending[i];
     if (face_piece_[static_cast<std::size_t>(f)] >= 0) continue;
     const auto tri = faces_[static_cast<std::size_t>(f)];
     const std::int32_t p = piece_of_[static_cast<std::size_t>(tri[0])];
@@ -1396,7 +1401,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
     for (int k = 0; k < 3; ++k) {
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
       if (bending) bend_dirty_.emplace_back(a, b);
-      if (edge_link_.find(a, b) >= 0) continue;
+      if (!(new_edges[i] >> k & 1u)) continue;  // it has its link
       const double kept = kept_rest(a, b, a, b, false);
       if (kept >= 0) {
         add_link(p, a, b, kept);
