@@ -319,6 +319,53 @@ TEST(PluginTopology, EditsKeepBendingLinksAcrossEdgesOfTwoFacesOnly) {
     ASSERT_TRUE(body.position(v).allFinite() && body.velocity(v).allFinite());
 }
 
+// The piece a cut moves into a new body starts in arrays sized for it; later edits that add
+// more nodes, faces and links than that room make them grow (and every pointer follow).
+TEST(PluginTopology, EditsOnASplitOffPieceGrowItsArrays) {
+  LiveArm a;
+  auto& body = *a.body;
+  const auto cut = body.cut(cga::Plane<double>::from_normal_point({0, 0, 1}, {0, 0, 0.42}));
+  ASSERT_EQ(cut.status, mesh::CutStatus::Cut);
+  ASSERT_EQ(body.piece_count(), 2);
+  a.w.step(5);
+  // The new body: the one not holding vertex 0 (the shoulder end).
+  btSoftBody* hand = nullptr;
+  for (btSoftBody* sb : body.pieces())
+    if (sb != body.body_of(0)) hand = sb;
+  ASSERT_NE(hand, nullptr);
+  const int nodes_before = hand->m_nodes.size(), faces_before = hand->m_faces.size();
+  int drilled = 0;
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+      if (body.body_of(v) == hand) c += body.position(v), ++n;
+    c /= n;
+    c.z() += 0.02 * (i - 1);
+    const Snapshot before = [&] {
+      Snapshot s;  // snapshot() expects no detached vertex; only the sums are compared here
+      s.mass = body.total_mass();
+      s.momentum = body.momentum();
+      s.scale = body.momentum_scale();
+      return s;
+    }();
+    const auto result =
+        body.drill({c + Eigen::Vector3d(0, 0.2, 0), c - Eigen::Vector3d(0, 0.2, 0), 0.008});
+    drilled += result.holes;
+    EXPECT_NEAR(body.total_mass(), before.mass, 1e-9 * before.mass);
+    EXPECT_LT((body.momentum() - before.momentum).norm(), 1e-9 * before.scale);
+    expect_mirrors_mesh(body, "drill in the split-off piece");
+    a.w.step(2);
+  }
+  EXPECT_GT(drilled, 0);
+  EXPECT_GT(hand->m_nodes.size(), nodes_before + 16);  // past the room it was made with
+  EXPECT_GT(hand->m_faces.size(), faces_before + 16);
+  a.w.step(20);
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+    ASSERT_TRUE(body.position(v).allFinite() && body.velocity(v).allFinite());
+  expect_mirrors_mesh(body, "split-off piece, 20 steps later");
+}
+
 // A change that only removes the faces whose rest centroid satisfies `remove`.
 template <class Predicate>
 mesh::TopologyChange remove_faces_where(const mesh::SkinnedMesh& m, Predicate remove) {
