@@ -15,6 +15,9 @@
 // by the same plane, with clip_volume = cap; the run ends with the ratios CGAL / ours of the
 // median times. CGAL's clip keeps one side; our cut keeps both and labels the pieces.
 //
+// BM_ApplyOnly and BM_LabelPiecesOnly time the two steps of cut() after compute_cut alone:
+// applying the (capped) change with the adjacency kept, and labelling the pieces.
+//
 // Every benchmark times only the operation (manual time, in thread CPU time): restoring the
 // mesh is not timed. Iteration counts are fixed at 500k and 2M faces, where the untimed set-up
 // (copying the mesh) would otherwise dominate the run. Run with
@@ -113,6 +116,37 @@ void compute_bench(benchmark::State& state, int faces) {
   }
   state.counters["faces"] = static_cast<double>(m.mesh.face_count());
   speedup(state, kPaperCutSeconds, total);
+}
+
+// apply() alone: the cut's change (with caps) applied to a copy of the arm, keeping the
+// adjacency, as cut() does between compute_cut and label_pieces. The drill and the tear apply
+// their changes through the same function.
+void apply_bench(benchmark::State& state, int faces) {
+  const Model& m = model(faces);
+  const CutResult r = compute_cut(m.mesh, kCutPlane, {.cap = true});
+  double total = 0;
+  for (auto _ : state) {
+    SkinnedMesh mesh = m.mesh;
+    Adjacency adjacency = m.adjacency;
+    total += timed(state, [&] { apply(mesh, r.change, &adjacency); });
+    benchmark::DoNotOptimize(mesh.faces.data());
+  }
+  state.counters["new_vertices"] = static_cast<double>(r.change.new_vertices.size());
+  state.counters["added_faces"] = static_cast<double>(r.change.added_faces.size());
+  state.counters["removed_faces"] = static_cast<double>(r.change.removed_faces.size());
+}
+
+// label_pieces alone, on the arm after the cut.
+void label_bench(benchmark::State& state, int faces) {
+  SkinnedMesh mesh = model(faces).mesh;
+  Adjacency adjacency = model(faces).adjacency;
+  cut(mesh, adjacency, kCutPlane, {.cap = true});
+  std::int32_t pieces = 0;
+  for (auto _ : state) {
+    timed(state, [&] { pieces = label_pieces(mesh).count; });
+    benchmark::DoNotOptimize(pieces);
+  }
+  state.counters["pieces"] = pieces;
 }
 
 #if CONFORM_HAVE_CGAL
@@ -276,6 +310,10 @@ void register_all() {
     }
     fixed(benchmark::RegisterBenchmark(("BM_CutComputeOnly" + size).c_str(),
                                        [=](benchmark::State& s) { compute_bench(s, faces); }));
+    fixed(benchmark::RegisterBenchmark(("BM_ApplyOnly" + size).c_str(),
+                                       [=](benchmark::State& s) { apply_bench(s, faces); }));
+    fixed(benchmark::RegisterBenchmark(("BM_LabelPiecesOnly" + size).c_str(),
+                                       [=](benchmark::State& s) { label_bench(s, faces); }));
   }
   for (int e = 0; e < 2; ++e) {
     const std::string arg = "/euclidean:" + std::to_string(e);
