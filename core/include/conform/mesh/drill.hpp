@@ -35,6 +35,8 @@
 //      tube_ring_spacing > 0, intermediate rings of new vertices (each on the segment from a
 //      rim vertex to its partner, the other rim's vertex nearest in angle) split the wall so
 //      that its triangles are about as long as wide instead of spanning the whole wall.
+// Each thread keeps the drill's scratch tables between calls (sized by its largest drill so far),
+// so that drilling at haptic rates allocates almost nothing.
 // Given a FaceIndex, the drill refits it first if it was marked moved and updates it for every
 // change it applies. Without one, it scans every face once (O(F), cheaper than building an
 // index for one query): keep an index for haptic rates (see face_index.hpp for who refits when).
