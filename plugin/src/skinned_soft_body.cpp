@@ -333,6 +333,7 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
   faces_.reserve(2 * m.faces.size());
   face_piece_.reserve(2 * m.faces.size());
   face_slot_.reserve(2 * m.faces.size());
+  for (auto* table : {&edge_faces_, &edge_link_}) table->reserve(3 * m.faces.size() / 2);
   faces_ = m.faces;
   face_piece_.assign(faces_.size(), -1);
   face_slot_.assign(faces_.size(), -1);
@@ -346,8 +347,7 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
       vertex_faces_[static_cast<std::size_t>(v)].push_back(std::int32_t(f));
     for (int k = 0; k < 3; ++k) {
       const auto [a, b] = edge_key(faces_[f][k], faces_[f][(k + 1) % 3]);
-      const std::int32_t c = edge_faces_.find(a, b);
-      edge_faces_.insert(a, b, c < 0 ? 1 : c + 1, true);
+      ++edge_faces_.at(a, b, 0);
     }
   }
   const mesh::Pieces labels = mesh::label_pieces(m);
@@ -996,11 +996,9 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       else
         cluster[static_cast<std::size_t>(cluster_root(slot))] = first;
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
-      const std::int32_t c = edge_faces_.find(a, b) - 1;
-      if (c > 0) {
-        edge_faces_.insert(a, b, c, true);
-      } else {
-        edge_faces_.erase(a, b, c + 1);
+      std::int32_t& count = edge_faces_.at(a, b, 0);
+      if (--count <= 0) {
+        edge_faces_.erase(a, b, count);
         dropped.emplace_back(a, b);
       }
     }
@@ -1057,9 +1055,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
       vertex_faces_[static_cast<std::size_t>(tri[k])].push_back(pending[i]);
       seed(tri[k]);
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
-      const std::int32_t c = edge_faces_.find(a, b);
-      edge_faces_.insert(a, b, c < 0 ? 1 : c + 1, true);
-      if (c < 0) new_edges[i] |= std::uint8_t(1u << k);
+      if (++edge_faces_.at(a, b, 0) == 1) new_edges[i] |= std::uint8_t(1u << k);
     }
   }
   stats_.added_faces += std::int32_t(pending.size());
