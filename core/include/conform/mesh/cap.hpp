@@ -11,13 +11,21 @@
 //                        (exact predicates), faces kept by nesting parity (a walk from the
 //                        infinite face that flips parity across each loop edge). Available
 //                        when Conform was built with CGAL (libcgal-dev; an optional
-//                        dependency, see has_cgal_triangulator()).
+//                        dependency, see has_cgal_triangulator()). CGAL gets the loops'
+//                        corners, centred and sheared by 2^-32 (orientations kept, exact
+//                        cocircular ties broken): flat vertices (collinear with their
+//                        neighbours, every other vertex of a cut across split quads) and
+//                        symmetric sections otherwise send its filters to exact arithmetic.
+//                        The flat vertices are put back by splitting the triangle on their
+//                        edge, then Lawson's flips (as below) restore constrained Delaunay.
 //   EarClipping          nesting depths by point-in-polygon tests, each hole joined to the
-//                        loop around it by a bridge to a vertex it sees, ear clipping of each
-//                        merged polygon, then Lawson's flips of the inner edges to the
-//                        constrained Delaunay triangulation (floating-point predicates with a
-//                        tolerance). Always available; the fallback, and several times faster
-//                        than CGAL's on the cut's small sections.
+//                        loop around it by a bridge to a vertex it sees; a convex polygon is
+//                        triangulated as a strip taking the Delaunay diagonal at each step,
+//                        any other by ear clipping (a linked list, only reflex vertices
+//                        tested); then Lawson's flips of the inner edges to the constrained
+//                        Delaunay triangulation (floating-point predicates with a tolerance).
+//                        Always available; the fallback, and faster than CGAL's on the cut's
+//                        small sections.
 // Neither adds vertices: every triangle joins three loop vertices.
 #pragma once
 
