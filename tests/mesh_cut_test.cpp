@@ -12,6 +12,7 @@
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/primitives.hpp"
 #include "conform/mesh/procedural_arm.hpp"
+#include "skin_reference.hpp"
 
 using namespace conform;
 using namespace conform::mesh;
@@ -347,19 +348,6 @@ TEST(Cut, SnappingAvoidsSlivers) {
   expect_valid(s, s0, "snapped");
 }
 
-// Linear-blend skinning with one versor per bone, applied through the weights.
-Eigen::Matrix3Xd lbs(const SkinnedMesh& m, const std::vector<cga::Versor<double>>& pose) {
-  Eigen::Matrix3Xd out(3, m.rest.cols());
-  for (Eigen::Index v = 0; v < m.rest.cols(); ++v) {
-    Eigen::Vector3d x = Eigen::Vector3d::Zero();
-    for (int k = 0; k < kMaxInfluences; ++k)
-      if (m.weights(k, v) != 0)
-        x += m.weights(k, v) * pose[static_cast<std::size_t>(m.bones(k, v))].apply(m.rest.col(v));
-    out.col(v) = x;
-  }
-  return out;
-}
-
 TEST(Cut, ReDeformation) {
   // Cut the posed mesh, then re-skin the result with another pose, against skinning the
   // original with that pose and applying the same change.
@@ -372,15 +360,15 @@ TEST(Cut, ReDeformation) {
                                 V::from_motor(M::from_axis_angle({1, 1, 0}, -0.7)),
                                 V{M::from_axis_angle({0, 0, 1}, 0.5), 0.8}};
   SkinnedMesh posed = original;
-  posed.current = lbs(original, pose1);
+  posed.current = conform::test::reference_lbs(original, pose1);
   for (const double z : {0.12, 0.31, 0.5, 0.58}) {  // upper arm, elbow, forearm/wrist blend, hand
     SkinnedMesh a = posed;
     Adjacency adj(a);
     const auto out = cut(a, adj, Plane::from_normal_point({0.2, 0.1, 1}, {0, 0, z}), {.cap = true});
     ASSERT_EQ(out.result.status, CutStatus::Cut);
-    a.current = lbs(a, pose2);  // re-skin the changed mesh
+    a.current = conform::test::reference_lbs(a, pose2);  // re-skin the changed mesh
     SkinnedMesh b = original;
-    b.current = lbs(original, pose2);
+    b.current = conform::test::reference_lbs(original, pose2);
     apply(b, out.result.change);  // the same change applied to the re-posed original
     ASSERT_EQ(a.vertex_count(), b.vertex_count());
     EXPECT_EQ(a.faces, b.faces);

@@ -11,6 +11,7 @@
 #include "conform/mesh/face_index.hpp"
 #include "conform/mesh/primitives.hpp"
 #include "conform/mesh/procedural_arm.hpp"
+#include "skin_reference.hpp"
 
 using namespace conform::mesh;
 
@@ -321,19 +322,6 @@ TEST(Drill, PropertyRandomTubesThroughTheArm) {
 
 namespace {
 
-// Linear-blend skinning with one versor per bone, applied through the weights.
-Eigen::Matrix3Xd lbs(const SkinnedMesh& m, const std::vector<conform::cga::Versor<double>>& pose) {
-  Eigen::Matrix3Xd out(3, m.rest.cols());
-  for (Eigen::Index v = 0; v < m.rest.cols(); ++v) {
-    Eigen::Vector3d x = Eigen::Vector3d::Zero();
-    for (int k = 0; k < kMaxInfluences; ++k)
-      if (m.weights(k, v) != 0)
-        x += m.weights(k, v) * pose[static_cast<std::size_t>(m.bones(k, v))].apply(m.rest.col(v));
-    out.col(v) = x;
-  }
-  return out;
-}
-
 double longest_edge(const SkinnedMesh& m) {
   double longest = 0;
   for (const Face& f : m.faces)
@@ -491,7 +479,7 @@ TEST(Drill, ReDeformation) {
                                 V::from_motor(M::from_axis_angle({1, 1, 0}, -0.7)),
                                 V{M::from_axis_angle({0, 0, 1}, 0.5), 0.8}};
   SkinnedMesh posed = original;
-  posed.current = lbs(original, pose1);
+  posed.current = conform::test::reference_lbs(original, pose1);
   for (const double z : {0.15, 0.31, 0.42}) {  // upper arm, elbow, forearm
     SkinnedMesh a = posed;
     Adjacency adj(a);
@@ -509,9 +497,9 @@ TEST(Drill, ReDeformation) {
         a, adj, {c + Eigen::Vector3d(0.3, 0.02, 0), c - Eigen::Vector3d(0.3, -0.02, 0), 0.008},
         options);
     ASSERT_EQ(d.holes, 2) << "z " << z << ": " << d.message;
-    a.current = lbs(a, pose2);
+    a.current = conform::test::reference_lbs(a, pose2);
     SkinnedMesh b = original;
-    b.current = lbs(original, pose2);
+    b.current = conform::test::reference_lbs(original, pose2);
     for (const TopologyChange& ch : d.changes) apply(b, ch);
     ASSERT_EQ(a.vertex_count(), b.vertex_count());
     EXPECT_EQ(a.faces, b.faces);

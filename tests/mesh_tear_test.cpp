@@ -11,6 +11,7 @@
 #include "conform/mesh/primitives.hpp"
 #include "conform/mesh/procedural_arm.hpp"
 #include "conform/mesh/tear.hpp"
+#include "skin_reference.hpp"
 
 using namespace conform;
 using namespace conform::mesh;
@@ -176,19 +177,6 @@ TEST(Tear, PropertyRandomScalpelPaths) {
   EXPECT_GT(extended, attempted * 8 / 10);
 }
 
-// Linear-blend skinning with one versor per bone.
-Eigen::Matrix3Xd lbs(const SkinnedMesh& m, const std::vector<cga::Versor<double>>& pose) {
-  Eigen::Matrix3Xd out(3, m.rest.cols());
-  for (Eigen::Index v = 0; v < m.rest.cols(); ++v) {
-    Eigen::Vector3d x = Eigen::Vector3d::Zero();
-    for (int k = 0; k < kMaxInfluences; ++k)
-      if (m.weights(k, v) != 0)
-        x += m.weights(k, v) * pose[static_cast<std::size_t>(m.bones(k, v))].apply(m.rest.col(v));
-    out.col(v) = x;
-  }
-  return out;
-}
-
 TEST(Tear, ReDeformation) {
   // Tear the posed arm across the elbow's blend, then re-skin with another pose, against the
   // original re-skinned with the same changes applied.
@@ -208,9 +196,9 @@ TEST(Tear, ReDeformation) {
       changes.push_back(std::move(c));
   }
   ASSERT_GT(tear.steps(), 20) << tear.message();
-  a.current = lbs(a, pose2);
+  a.current = conform::test::reference_lbs(a, pose2);
   SkinnedMesh b = original;
-  b.current = lbs(original, pose2);
+  b.current = conform::test::reference_lbs(original, pose2);
   for (const auto& c : changes) apply(b, c);
   ASSERT_EQ(a.faces, b.faces);
   double worst = 0;
