@@ -1,7 +1,7 @@
 // EdgeTable (the plugin's per-edge books) against std::map under random inserts, overwrites,
 // counted updates and erasures, including erasures with stale values and runs that wrap around
 // the end of the table (backward-shift deletion must keep every remaining key findable).
-#include "conform/bullet/edge_table.hpp"
+#include "edge_table.hpp"
 
 #include <gtest/gtest.h>
 

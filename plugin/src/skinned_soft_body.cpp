@@ -15,6 +15,7 @@
 
 #include "conform/bullet/convert.hpp"
 #include "conform/mesh/analysis.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 
@@ -41,7 +42,7 @@ void erase_value(std::vector<std::int32_t>& list, std::int32_t value) {
 
 }  // namespace
 
-struct SkinnedSoftBody::Piece {
+struct SkinnedSoftBody::Impl::Piece {
   // Memory the body's node, face and link arrays start in (see move_to_new_piece); declared
   // first, so it outlives the body (which never frees memory it does not own).
   struct Release {
@@ -225,10 +226,9 @@ void build_node_tree(btSoftBody& body, std::vector<btDbvtNode*>& pool) {
 
 }  // namespace
 
-SkinnedSoftBody::SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
-                                 std::function<void(btSoftBody*)> remove,
-                                 const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton,
-                                 const Material& material)
+SkinnedSoftBody::Impl::Impl(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
+                            std::function<void(btSoftBody*)> remove, const mesh::SkinnedMesh& mesh,
+                            const skin::Skeleton& skeleton, const Material& material)
     : info_(&info),
       add_(std::move(add)),
       remove_(std::move(remove)),
@@ -290,16 +290,16 @@ SkinnedSoftBody::SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(b
   build(mesh_);
 }
 
-SkinnedSoftBody::~SkinnedSoftBody() {
+SkinnedSoftBody::Impl::~Impl() {
   for (auto& piece : pieces_)
     if (piece) remove_(piece->body.get());
 }
 
-bool SkinnedSoftBody::is_kinematic_by_weight(std::int32_t v) const {
+bool SkinnedSoftBody::Impl::is_kinematic_by_weight(std::int32_t v) const {
   return mesh_.weights(0, v) >= material_.kinematic_weight;
 }
 
-SkinnedSoftBody::Piece& SkinnedSoftBody::new_piece() {
+SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece() {
   auto piece = std::make_unique<Piece>();
   // This constructor (unlike the world-info-only one) creates the default material.
   piece->body = std::make_unique<btSoftBody>(info_, 0, nullptr, nullptr);
@@ -320,7 +320,7 @@ SkinnedSoftBody::Piece& SkinnedSoftBody::new_piece() {
   return *pieces_.back();
 }
 
-void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
+void SkinnedSoftBody::Impl::build(const mesh::SkinnedMesh& m) {
   const auto n = static_cast<std::size_t>(m.vertex_count());
   // Room for edits to grow the per-vertex and per-face tables in place (a reallocation would
   // copy the whole table during an edit).
@@ -415,7 +415,7 @@ void SkinnedSoftBody::build(const mesh::SkinnedMesh& m) {
 // --- Bullet edits. None sets Bullet's whole-body reset (m_bUpdateRtCst): the constants of
 // what changed are written here. ---
 
-void SkinnedSoftBody::set_node_mass(std::int32_t v) {
+void SkinnedSoftBody::Impl::set_node_mass(std::int32_t v) {
   const auto i = static_cast<std::size_t>(v);
   if (piece_of_[i] < 0) return;
   btSoftBody::Node& node = body_of(v)->m_nodes[node_of_[i]];
@@ -425,7 +425,7 @@ void SkinnedSoftBody::set_node_mass(std::int32_t v) {
   update_link_constants(v);
 }
 
-void SkinnedSoftBody::update_link_constants(std::int32_t v) {
+void SkinnedSoftBody::Impl::update_link_constants(std::int32_t v) {
   btSoftBody& body = *body_of(v);
   const btSoftBody::Node* node = &body.m_nodes[node_of_[static_cast<std::size_t>(v)]];
   auto touch = [&](std::int32_t li) {
@@ -442,7 +442,7 @@ void SkinnedSoftBody::update_link_constants(std::int32_t v) {
   }
 }
 
-void SkinnedSoftBody::update_node_area(std::int32_t v) {
+void SkinnedSoftBody::Impl::update_node_area(std::int32_t v) {
   const auto i = static_cast<std::size_t>(v);
   if (piece_of_[i] < 0) return;
   btSoftBody& body = *body_of(v);
@@ -454,8 +454,8 @@ void SkinnedSoftBody::update_node_area(std::int32_t v) {
   body.m_nodes[node_of_[i]].m_area = count ? sum / btScalar(count) : btScalar(0);
 }
 
-void SkinnedSoftBody::add_node(std::int32_t p, std::int32_t v, const Eigen::Vector3d& x,
-                               const Eigen::Vector3d& vel, std::int32_t near) {
+void SkinnedSoftBody::Impl::add_node(std::int32_t p, std::int32_t v, const Eigen::Vector3d& x,
+                                     const Eigen::Vector3d& vel, std::int32_t near) {
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
   btDbvtNode* beside = near >= 0 && piece_of_[static_cast<std::size_t>(near)] == p
@@ -484,7 +484,7 @@ void SkinnedSoftBody::add_node(std::int32_t p, std::int32_t v, const Eigen::Vect
   node.m_im = kinematic_[i] ? btScalar(0) : btScalar(1 / mass_[i]);
 }
 
-void SkinnedSoftBody::remove_node(std::int32_t v) {
+void SkinnedSoftBody::Impl::remove_node(std::int32_t v) {
   // Swap-with-last: the last node moves into the hole and the faces and links that point to
   // it (found through its mesh faces) are re-pointed. v's own faces and links must be gone.
   const auto iv = static_cast<std::size_t>(v);
@@ -524,7 +524,7 @@ void SkinnedSoftBody::remove_node(std::int32_t v) {
   node_of_[iv] = -1;
 }
 
-void SkinnedSoftBody::detach(std::int32_t v) {
+void SkinnedSoftBody::Impl::detach(std::int32_t v) {
   const auto i = static_cast<std::size_t>(v);
   const Eigen::Vector3d x = position(v), vel = velocity(v);
   remove_node(v);
@@ -535,7 +535,7 @@ void SkinnedSoftBody::detach(std::int32_t v) {
   ++stats_.detached_nodes;
 }
 
-void SkinnedSoftBody::add_face(std::int32_t p, std::int32_t f) {
+void SkinnedSoftBody::Impl::add_face(std::int32_t p, std::int32_t f) {
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
   const auto& tri = faces_[static_cast<std::size_t>(f)];
@@ -551,7 +551,7 @@ void SkinnedSoftBody::add_face(std::int32_t p, std::int32_t f) {
   piece.face_id.push_back(f);
 }
 
-void SkinnedSoftBody::remove_face_from_bullet(std::int32_t f) {
+void SkinnedSoftBody::Impl::remove_face_from_bullet(std::int32_t f) {
   const std::int32_t p = face_piece_[static_cast<std::size_t>(f)];
   if (p < 0) return;
   if (material_.bending_stiffness > 0) {
@@ -567,7 +567,7 @@ void SkinnedSoftBody::remove_face_from_bullet(std::int32_t f) {
   ++stats_.removed_faces;
 }
 
-void SkinnedSoftBody::remove_face_slot(std::int32_t f) {
+void SkinnedSoftBody::Impl::remove_face_slot(std::int32_t f) {
   const std::int32_t p = face_piece_[static_cast<std::size_t>(f)];
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
@@ -585,7 +585,7 @@ void SkinnedSoftBody::remove_face_slot(std::int32_t f) {
   face_slot_[static_cast<std::size_t>(f)] = -1;
 }
 
-void SkinnedSoftBody::add_link(std::int32_t p, std::int32_t u, std::int32_t v, double rest) {
+void SkinnedSoftBody::Impl::add_link(std::int32_t p, std::int32_t u, std::int32_t v, double rest) {
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
   const bool reset = body.m_bUpdateRtCst;
@@ -604,8 +604,8 @@ void SkinnedSoftBody::add_link(std::int32_t p, std::int32_t u, std::int32_t v, d
   ++stats_.added_links;
 }
 
-void SkinnedSoftBody::add_bending(std::int32_t p, std::int32_t a, std::int32_t b, std::int32_t c,
-                                  std::int32_t d, double rest) {
+void SkinnedSoftBody::Impl::add_bending(std::int32_t p, std::int32_t a, std::int32_t b,
+                                        std::int32_t c, std::int32_t d, double rest) {
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   btSoftBody& body = *piece.body;
   const bool reset = body.m_bUpdateRtCst;
@@ -625,7 +625,7 @@ void SkinnedSoftBody::add_bending(std::int32_t p, std::int32_t a, std::int32_t b
   ++stats_.added_bending;
 }
 
-void SkinnedSoftBody::remove_bending(std::int32_t a, std::int32_t b) {
+void SkinnedSoftBody::Impl::remove_bending(std::int32_t a, std::int32_t b) {
   const std::int32_t li = bend_link_.find(a, b);
   if (li < 0) return;
   const std::int32_t p = piece_of_[static_cast<std::size_t>(a)];
@@ -640,7 +640,7 @@ void SkinnedSoftBody::remove_bending(std::int32_t a, std::int32_t b) {
   ++stats_.removed_bending;
 }
 
-void SkinnedSoftBody::remove_link(std::int32_t p, std::int32_t li) {
+void SkinnedSoftBody::Impl::remove_link(std::int32_t p, std::int32_t li) {
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
   const auto [a, b] = piece.link_key[static_cast<std::size_t>(li)];
   (piece.link_bend[static_cast<std::size_t>(li)] ? bend_link_ : edge_link_).erase(a, b, li);
@@ -648,7 +648,7 @@ void SkinnedSoftBody::remove_link(std::int32_t p, std::int32_t li) {
   ++stats_.removed_links;
 }
 
-void SkinnedSoftBody::pop_link(std::int32_t p, std::int32_t li) {
+void SkinnedSoftBody::Impl::pop_link(std::int32_t p, std::int32_t li) {
   // Swap-with-last; the key of the link that fills the hole is updated, li's own is left to
   // the caller.
   Piece& piece = *pieces_[static_cast<std::size_t>(p)];
@@ -670,21 +670,21 @@ void SkinnedSoftBody::pop_link(std::int32_t p, std::int32_t li) {
   piece.link_bend.pop_back();
 }
 
-void SkinnedSoftBody::keep_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
-                                double rest, bool bending) {
+void SkinnedSoftBody::Impl::keep_rest(std::int32_t a, std::int32_t b, std::int32_t c,
+                                      std::int32_t d, double rest, bool bending) {
   (bending ? relink_bend_ : relink_edge_).insert(a, b, std::int32_t(relink_.size()), true);
   relink_.emplace_back(a, b, c, d, rest);
 }
 
-double SkinnedSoftBody::kept_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
-                                  bool bending) const {
+double SkinnedSoftBody::Impl::kept_rest(std::int32_t a, std::int32_t b, std::int32_t c,
+                                        std::int32_t d, bool bending) const {
   const std::int32_t i = (bending ? relink_bend_ : relink_edge_).find(a, b);
   if (i < 0) return -1;
   const auto& [ka, kb, kc, kd, rest] = relink_[static_cast<std::size_t>(i)];
   return kc == c && kd == d ? rest : -1;
 }
 
-void SkinnedSoftBody::clear_kept() {
+void SkinnedSoftBody::Impl::clear_kept() {
   for (std::size_t i = 0; i < relink_.size(); ++i) {
     const auto& [a, b, c, d, rest] = relink_[i];
     const bool bending = !(a == c && b == d);
@@ -693,7 +693,7 @@ void SkinnedSoftBody::clear_kept() {
   relink_.clear();
 }
 
-void SkinnedSoftBody::refresh_bending(std::int32_t a, std::int32_t b) {
+void SkinnedSoftBody::Impl::refresh_bending(std::int32_t a, std::int32_t b) {
   // A bending link across (a, b) iff exactly two faces use the edge, both in the same body;
   // it joins their third vertices. A link of the same vertices removed earlier in this change
   // (a face moved into another body) keeps its rest length.
@@ -717,7 +717,7 @@ void SkinnedSoftBody::refresh_bending(std::int32_t a, std::int32_t b) {
   add_bending(p, a, b, c, d, rest);
 }
 
-void SkinnedSoftBody::remove_nodes_highest_first(std::span<const std::int32_t> vertices) {
+void SkinnedSoftBody::Impl::remove_nodes_highest_first(std::span<const std::int32_t> vertices) {
   // The last nodes of a body are popped without a swap (and without re-pointing).
   std::vector<std::int32_t> order(vertices.begin(), vertices.end());
   std::sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) {
@@ -726,8 +726,9 @@ void SkinnedSoftBody::remove_nodes_highest_first(std::span<const std::int32_t> v
   for (const auto v : order) remove_node(v);
 }
 
-std::int32_t SkinnedSoftBody::move_to_new_piece(std::span<const std::int32_t> moving,
-                                                std::int32_t joining, std::int32_t added_faces) {
+std::int32_t SkinnedSoftBody::Impl::move_to_new_piece(std::span<const std::int32_t> moving,
+                                                      std::int32_t joining,
+                                                      std::int32_t added_faces) {
   // Every face of a moving vertex moves (the vertices are a whole connected piece), and with
   // them every edge and bending link touching them. Nodes, faces and links are copied whole,
   // so that state, rest lengths, link constants and face areas carry over bit-exact, with their
@@ -895,7 +896,7 @@ std::int32_t SkinnedSoftBody::move_to_new_piece(std::span<const std::int32_t> mo
   return into_index;
 }
 
-void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
+void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
   auto clock = Clock::now();
   auto& sec = stats_.seconds;
   const std::int32_t v0 = change.base_vertex_count;
@@ -1441,7 +1442,7 @@ void SkinnedSoftBody::mirror(const mesh::TopologyChange& change) {
   sec.insert += seconds_since(clock);
 }
 
-void SkinnedSoftBody::apply(const mesh::TopologyChange& change) {
+void SkinnedSoftBody::Impl::apply(const mesh::TopologyChange& change) {
   stats_ = {};
   auto clock = Clock::now();
   mesh::apply(mesh_, change, &adjacency_);
@@ -1450,13 +1451,13 @@ void SkinnedSoftBody::apply(const mesh::TopologyChange& change) {
   mirror(change);
 }
 
-void SkinnedSoftBody::sync_mesh() {
+void SkinnedSoftBody::Impl::sync_mesh() {
   for (std::int32_t v = 0; v < mesh_.vertex_count(); ++v) mesh_.current.col(v) = position(v);
   face_index_.mark_moved();
 }
 
-mesh::CutResult SkinnedSoftBody::cut(const cga::Plane<double>& plane,
-                                     const mesh::CutOptions& options) {
+mesh::CutResult SkinnedSoftBody::Impl::cut(const cga::Plane<double>& plane,
+                                           const mesh::CutOptions& options) {
   stats_ = {};
   auto clock = Clock::now();
   sync_mesh();
@@ -1469,8 +1470,8 @@ mesh::CutResult SkinnedSoftBody::cut(const cga::Plane<double>& plane,
   return result;
 }
 
-mesh::DrillResult SkinnedSoftBody::drill(const mesh::DrillTool& tool,
-                                         const mesh::DrillOptions& options) {
+mesh::DrillResult SkinnedSoftBody::Impl::drill(const mesh::DrillTool& tool,
+                                               const mesh::DrillOptions& options) {
   stats_ = {};
   auto clock = Clock::now();
   sync_mesh();
@@ -1481,11 +1482,11 @@ mesh::DrillResult SkinnedSoftBody::drill(const mesh::DrillTool& tool,
   return result;
 }
 
-void SkinnedSoftBody::begin_tear(const mesh::TearOptions& options) {
+void SkinnedSoftBody::Impl::begin_tear(const mesh::TearOptions& options) {
   tear_ = std::make_unique<mesh::Tear>(mesh_, adjacency_, face_index_, options);
 }
 
-mesh::TearStep SkinnedSoftBody::tear_advance(const mesh::ScalpelSample& sample) {
+mesh::TearStep SkinnedSoftBody::Impl::tear_advance(const mesh::ScalpelSample& sample) {
   if (!tear_) begin_tear();
   stats_ = {};
   auto clock = Clock::now();
@@ -1499,13 +1500,13 @@ mesh::TearStep SkinnedSoftBody::tear_advance(const mesh::ScalpelSample& sample) 
 
 // --- Pose and skinning ---
 
-void SkinnedSoftBody::set_pose(const skin::Pose& pose) {
+void SkinnedSoftBody::Impl::set_pose(const skin::Pose& pose) {
   if (pose.local.size() != global_.size())
     throw std::invalid_argument("set_pose: wrong joint count");
   source_ = [pose](double, skin::Pose& out) { out = pose; };
 }
 
-void SkinnedSoftBody::play(const skin::Animation& animation, skin::Blend blend, bool loop) {
+void SkinnedSoftBody::Impl::play(const skin::Animation& animation, skin::Blend blend, bool loop) {
   source_ = [this, animation, blend, loop](double time, skin::Pose& out) {
     const double d = animation.duration();
     const double t = loop && d > 0 ? std::fmod(time, d) : time;
@@ -1513,17 +1514,17 @@ void SkinnedSoftBody::play(const skin::Animation& animation, skin::Blend blend, 
   };
 }
 
-void SkinnedSoftBody::set_keyframes(skin::PoseTrack track, skin::Blend blend) {
+void SkinnedSoftBody::Impl::set_keyframes(skin::PoseTrack track, skin::Blend blend) {
   source_ = [track = std::move(track), blend](double time, skin::Pose& out) {
     track.sample(time, blend, out);
   };
 }
 
-void SkinnedSoftBody::set_pose_source(std::function<void(double, skin::Pose&)> source) {
+void SkinnedSoftBody::Impl::set_pose_source(std::function<void(double, skin::Pose&)> source) {
   source_ = std::move(source);
 }
 
-void SkinnedSoftBody::set_pinned(std::span<const std::int32_t> vertices) {
+void SkinnedSoftBody::Impl::set_pinned(std::span<const std::int32_t> vertices) {
   std::fill(pinned_.begin(), pinned_.end(), 0);
   for (const auto v : vertices) pinned_.at(static_cast<std::size_t>(v)) = 1;
   for (std::int32_t v = 0; v < vertex_count(); ++v) {
@@ -1535,11 +1536,11 @@ void SkinnedSoftBody::set_pinned(std::span<const std::int32_t> vertices) {
   }
 }
 
-void SkinnedSoftBody::pose_at(double time, skin::Pose& pose) {
+void SkinnedSoftBody::Impl::pose_at(double time, skin::Pose& pose) {
   if (source_) source_(time, pose);
 }
 
-void SkinnedSoftBody::rebuild_skin_inputs() {
+void SkinnedSoftBody::Impl::rebuild_skin_inputs() {
   const auto n = static_cast<std::size_t>(mesh_.vertex_count());
   rest_soa_ = skin::SoaPoints<double>::from(mesh_.rest);
   soa_bones_.resize(n * mesh::kMaxInfluences);
@@ -1557,7 +1558,7 @@ void SkinnedSoftBody::rebuild_skin_inputs() {
   fill_previous_ = true;
 }
 
-void SkinnedSoftBody::skin_targets(double time) {
+void SkinnedSoftBody::Impl::skin_targets(double time) {
   if (rest_soa_.size() != static_cast<std::size_t>(mesh_.vertex_count())) rebuild_skin_inputs();
   pose_at(time, pose_);
   skin::global_versors(skeleton_, pose_, global_);
@@ -1572,7 +1573,7 @@ void SkinnedSoftBody::skin_targets(double time) {
   job.run();
 }
 
-void SkinnedSoftBody::update(double dt, double time) {
+void SkinnedSoftBody::Impl::update(double dt, double time) {
   if (!(dt > 0)) return;
   std::swap(previous_target_, target_);
   skin_targets(time);  // resizes both after vertices were added (new previous entries NaN)
@@ -1628,24 +1629,24 @@ void SkinnedSoftBody::update(double dt, double time) {
 
 // --- Queries ---
 
-std::int32_t SkinnedSoftBody::piece_count() const {
+std::int32_t SkinnedSoftBody::Impl::piece_count() const {
   return std::int32_t(std::count_if(pieces_.begin(), pieces_.end(),
                                     [](auto& p) { return p && p->body->m_faces.size() > 0; }));
 }
 
-std::vector<btSoftBody*> SkinnedSoftBody::pieces() const {
+std::vector<btSoftBody*> SkinnedSoftBody::Impl::pieces() const {
   std::vector<btSoftBody*> out;
   for (const auto& p : pieces_)
     if (p) out.push_back(p->body.get());
   return out;
 }
 
-btSoftBody* SkinnedSoftBody::body_of(std::int32_t v) const {
+btSoftBody* SkinnedSoftBody::Impl::body_of(std::int32_t v) const {
   const std::int32_t p = piece_of_[static_cast<std::size_t>(v)];
   return p < 0 ? nullptr : pieces_[static_cast<std::size_t>(p)]->body.get();
 }
 
-std::int32_t SkinnedSoftBody::vertex_of(const btSoftBody* body, int node) const {
+std::int32_t SkinnedSoftBody::Impl::vertex_of(const btSoftBody* body, int node) const {
   for (const auto& p : pieces_)
     if (p && p->body.get() == body)
       return node >= 0 && std::size_t(node) < p->node_vertex.size()
@@ -1654,44 +1655,44 @@ std::int32_t SkinnedSoftBody::vertex_of(const btSoftBody* body, int node) const 
   return -1;
 }
 
-Eigen::Vector3d SkinnedSoftBody::position(std::int32_t v) const {
+Eigen::Vector3d SkinnedSoftBody::Impl::position(std::int32_t v) const {
   const auto i = static_cast<std::size_t>(v);
   if (piece_of_[i] < 0) return detached_state_[static_cast<std::size_t>(detached_slot_[i])].first;
   return to_eigen(body_of(v)->m_nodes[node_of_[i]].m_x);
 }
 
-Eigen::Vector3d SkinnedSoftBody::velocity(std::int32_t v) const {
+Eigen::Vector3d SkinnedSoftBody::Impl::velocity(std::int32_t v) const {
   const auto i = static_cast<std::size_t>(v);
   if (piece_of_[i] < 0) return detached_state_[static_cast<std::size_t>(detached_slot_[i])].second;
   return to_eigen(body_of(v)->m_nodes[node_of_[i]].m_v);
 }
 
-Eigen::Vector3d SkinnedSoftBody::target(std::int32_t v) const {
+Eigen::Vector3d SkinnedSoftBody::Impl::target(std::int32_t v) const {
   const auto i = static_cast<std::size_t>(v);
   return {target_.x.at(i), target_.y.at(i), target_.z.at(i)};
 }
 
-double SkinnedSoftBody::total_mass() const {
+double SkinnedSoftBody::Impl::total_mass() const {
   double m = 0;
   for (const double x : mass_) m += x;
   return m;
 }
 
-Eigen::Vector3d SkinnedSoftBody::momentum() const {
+Eigen::Vector3d SkinnedSoftBody::Impl::momentum() const {
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
   for (std::int32_t v = 0; v < vertex_count(); ++v)
     p += mass_[static_cast<std::size_t>(v)] * velocity(v);
   return p;
 }
 
-double SkinnedSoftBody::momentum_scale() const {
+double SkinnedSoftBody::Impl::momentum_scale() const {
   double s = 0;
   for (std::int32_t v = 0; v < vertex_count(); ++v)
     s += mass_[static_cast<std::size_t>(v)] * velocity(v).norm();
   return s;
 }
 
-double SkinnedSoftBody::rest_length(std::int32_t u, std::int32_t v) const {
+double SkinnedSoftBody::Impl::rest_length(std::int32_t u, std::int32_t v) const {
   const auto [a, b] = edge_key(u, v);
   const std::int32_t li = edge_link_.find(a, b);
   const std::int32_t p = piece_of_[static_cast<std::size_t>(a)];
@@ -1699,7 +1700,7 @@ double SkinnedSoftBody::rest_length(std::int32_t u, std::int32_t v) const {
   return pieces_[static_cast<std::size_t>(p)]->rest[static_cast<std::size_t>(li)];
 }
 
-double SkinnedSoftBody::bending_rest_length(std::int32_t u, std::int32_t v) const {
+double SkinnedSoftBody::Impl::bending_rest_length(std::int32_t u, std::int32_t v) const {
   const auto [a, b] = edge_key(u, v);
   const std::int32_t li = bend_link_.find(a, b);
   const std::int32_t p = piece_of_[static_cast<std::size_t>(a)];
@@ -1707,18 +1708,151 @@ double SkinnedSoftBody::bending_rest_length(std::int32_t u, std::int32_t v) cons
   return pieces_[static_cast<std::size_t>(p)]->rest[static_cast<std::size_t>(li)];
 }
 
-std::int32_t SkinnedSoftBody::link_count() const {
+std::int32_t SkinnedSoftBody::Impl::link_count() const {
   std::int32_t n = 0;
   for (const auto& p : pieces_)
     if (p) n += p->body->m_links.size() - p->bending;
   return n;
 }
 
-std::int32_t SkinnedSoftBody::bending_link_count() const {
+std::int32_t SkinnedSoftBody::Impl::bending_link_count() const {
   std::int32_t n = 0;
   for (const auto& p : pieces_)
     if (p) n += p->bending;
   return n;
+}
+
+// --- SkinnedSoftBody: forwards to its Impl ---
+
+SkinnedSoftBody::SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
+                                 std::function<void(btSoftBody*)> remove,
+                                 const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton,
+                                 const Material& material)
+    : impl_(std::make_unique<Impl>(info, std::move(add), std::move(remove), mesh, skeleton,
+                                   material)) {}
+SkinnedSoftBody::~SkinnedSoftBody() = default;
+
+void SkinnedSoftBody::set_pose(const skin::Pose& pose) {
+  impl_->set_pose(pose);
+}
+void SkinnedSoftBody::play(const skin::Animation& animation, skin::Blend blend, bool loop) {
+  impl_->play(animation, blend, loop);
+}
+void SkinnedSoftBody::set_keyframes(skin::PoseTrack track, skin::Blend blend) {
+  impl_->set_keyframes(std::move(track), blend);
+}
+void SkinnedSoftBody::set_pose_source(std::function<void(double, skin::Pose&)> source) {
+  impl_->set_pose_source(std::move(source));
+}
+void SkinnedSoftBody::set_skin_threads(int threads) {
+  impl_->set_skin_threads(threads);
+}
+void SkinnedSoftBody::set_pinned(std::span<const std::int32_t> vertices) {
+  impl_->set_pinned(vertices);
+}
+
+mesh::CutResult SkinnedSoftBody::cut(const cga::Plane<double>& plane,
+                                     const mesh::CutOptions& options) {
+  return impl_->cut(plane, options);
+}
+mesh::DrillResult SkinnedSoftBody::drill(const mesh::DrillTool& tool,
+                                         const mesh::DrillOptions& options) {
+  return impl_->drill(tool, options);
+}
+void SkinnedSoftBody::begin_tear(const mesh::TearOptions& options) {
+  impl_->begin_tear(options);
+}
+mesh::TearStep SkinnedSoftBody::tear_advance(const mesh::ScalpelSample& sample) {
+  return impl_->tear_advance(sample);
+}
+const mesh::Tear* SkinnedSoftBody::tear() const {
+  return impl_->tear();
+}
+void SkinnedSoftBody::apply(const mesh::TopologyChange& change) {
+  impl_->apply(change);
+}
+const ApplyStats& SkinnedSoftBody::last_apply() const {
+  return impl_->last_apply();
+}
+
+const mesh::SkinnedMesh& SkinnedSoftBody::mesh() const {
+  return impl_->mesh();
+}
+const skin::Skeleton& SkinnedSoftBody::skeleton() const {
+  return impl_->skeleton();
+}
+const Material& SkinnedSoftBody::material() const {
+  return impl_->material();
+}
+void SkinnedSoftBody::sync_mesh() {
+  impl_->sync_mesh();
+}
+std::int32_t SkinnedSoftBody::vertex_count() const {
+  return impl_->vertex_count();
+}
+std::int32_t SkinnedSoftBody::piece_count() const {
+  return impl_->piece_count();
+}
+std::vector<btSoftBody*> SkinnedSoftBody::pieces() const {
+  return impl_->pieces();
+}
+Eigen::Vector3d SkinnedSoftBody::position(std::int32_t vertex) const {
+  return impl_->position(vertex);
+}
+Eigen::Vector3d SkinnedSoftBody::velocity(std::int32_t vertex) const {
+  return impl_->velocity(vertex);
+}
+double SkinnedSoftBody::mass(std::int32_t vertex) const {
+  return impl_->mass(vertex);
+}
+bool SkinnedSoftBody::kinematic(std::int32_t vertex) const {
+  return impl_->kinematic(vertex);
+}
+btSoftBody* SkinnedSoftBody::body_of(std::int32_t vertex) const {
+  return impl_->body_of(vertex);
+}
+std::int32_t SkinnedSoftBody::vertex_of(const btSoftBody* body, int node) const {
+  return impl_->vertex_of(body, node);
+}
+std::int32_t SkinnedSoftBody::node_of(std::int32_t vertex) const {
+  return impl_->node_of(vertex);
+}
+Eigen::Vector3d SkinnedSoftBody::target(std::int32_t vertex) const {
+  return impl_->target(vertex);
+}
+double SkinnedSoftBody::total_mass() const {
+  return impl_->total_mass();
+}
+Eigen::Vector3d SkinnedSoftBody::momentum() const {
+  return impl_->momentum();
+}
+double SkinnedSoftBody::momentum_scale() const {
+  return impl_->momentum_scale();
+}
+double SkinnedSoftBody::rest_length(std::int32_t u, std::int32_t v) const {
+  return impl_->rest_length(u, v);
+}
+std::int32_t SkinnedSoftBody::link_count() const {
+  return impl_->link_count();
+}
+std::int32_t SkinnedSoftBody::bending_link_count() const {
+  return impl_->bending_link_count();
+}
+double SkinnedSoftBody::bending_rest_length(std::int32_t u, std::int32_t v) const {
+  return impl_->bending_rest_length(u, v);
+}
+bool SkinnedSoftBody::detached(std::int32_t vertex) const {
+  return impl_->detached(vertex);
+}
+std::int32_t SkinnedSoftBody::detached_count() const {
+  return impl_->detached_count();
+}
+
+void SkinnedSoftBody::update(double dt, double time) {
+  impl_->update(dt, time);
+}
+void SkinnedSoftBody::skin_targets(double time) {
+  impl_->skin_targets(time);
 }
 
 }  // namespace conform::bullet

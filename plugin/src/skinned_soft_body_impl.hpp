@@ -1,0 +1,176 @@
+// SkinnedSoftBody's private side: the books mirroring the mesh into Bullet (per vertex, per
+// face, per edge), the skinning buffers and the scratch of topology changes. The public class
+// forwards to it (skinned_soft_body.hpp describes the behaviour).
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "conform/bullet/skinned_soft_body.hpp"
+#include "conform/mesh/adjacency.hpp"
+#include "conform/mesh/face_index.hpp"
+#include "conform/skin/skinning.hpp"
+#include "edge_table.hpp"
+
+namespace conform::bullet {
+
+struct SkinnedSoftBody::Impl {
+  // The public methods, documented in skinned_soft_body.hpp.
+  Impl(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
+       std::function<void(btSoftBody*)> remove, const mesh::SkinnedMesh& mesh,
+       const skin::Skeleton& skeleton, const Material& material);
+  ~Impl();
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+
+  // --- Pose sources (the last one set wins). Time is the plugin's simulated time, s. ---
+  void set_pose(const skin::Pose& pose);
+  void play(const skin::Animation& animation, skin::Blend blend = skin::Blend::linear,
+            bool loop = true);
+  void set_keyframes(skin::PoseTrack track, skin::Blend blend = skin::Blend::linear);
+  void set_pose_source(std::function<void(double time, skin::Pose& pose)> source);
+  void set_skin_threads(int threads) { skin_threads_ = threads; }
+  void set_pinned(std::span<const std::int32_t> vertices);
+
+  // --- Topology changes: on the simulated positions, only between stepSimulation calls. ---
+  mesh::CutResult cut(const cga::Plane<double>& plane, const mesh::CutOptions& options = {});
+  mesh::DrillResult drill(const mesh::DrillTool& tool, const mesh::DrillOptions& options = {});
+  void begin_tear(const mesh::TearOptions& options = {});
+  mesh::TearStep tear_advance(const mesh::ScalpelSample& sample);
+  const mesh::Tear* tear() const { return tear_.get(); }
+  void apply(const mesh::TopologyChange& change);
+  const ApplyStats& last_apply() const { return stats_; }
+
+  // --- State ---
+  const mesh::SkinnedMesh& mesh() const { return mesh_; }
+  const skin::Skeleton& skeleton() const { return skeleton_; }
+  const Material& material() const { return material_; }
+  void sync_mesh();
+  std::int32_t vertex_count() const { return mesh_.vertex_count(); }
+  std::int32_t piece_count() const;
+  std::vector<btSoftBody*> pieces() const;
+  Eigen::Vector3d position(std::int32_t vertex) const;
+  Eigen::Vector3d velocity(std::int32_t vertex) const;
+  double mass(std::int32_t vertex) const { return mass_[static_cast<std::size_t>(vertex)]; }
+  bool kinematic(std::int32_t vertex) const { return kinematic_[static_cast<std::size_t>(vertex)]; }
+  btSoftBody* body_of(std::int32_t vertex) const;
+  std::int32_t vertex_of(const btSoftBody* body, int node) const;
+  std::int32_t node_of(std::int32_t vertex) const {
+    return node_of_[static_cast<std::size_t>(vertex)];
+  }
+  Eigen::Vector3d target(std::int32_t vertex) const;
+  double total_mass() const;
+  Eigen::Vector3d momentum() const;
+  double momentum_scale() const;
+  double rest_length(std::int32_t u, std::int32_t v) const;
+  std::int32_t link_count() const;
+  std::int32_t bending_link_count() const;
+  double bending_rest_length(std::int32_t u, std::int32_t v) const;
+  bool detached(std::int32_t vertex) const {
+    return piece_of_[static_cast<std::size_t>(vertex)] < 0;
+  }
+  std::int32_t detached_count() const { return detached_count_; }
+
+  void update(double dt, double time);
+  void skin_targets(double time);
+
+  // --- Details ---
+  struct Piece;
+  void pose_at(double time, skin::Pose& pose);
+  Piece& new_piece();
+  void build(const mesh::SkinnedMesh& mesh);
+  void mirror(const mesh::TopologyChange& change);
+  void rebuild_skin_inputs();
+  void set_node_mass(std::int32_t vertex);
+  /// `near`: a vertex next to it whose tree leaf it joins (−1: Bullet's own insert).
+  void add_node(std::int32_t piece, std::int32_t vertex, const Eigen::Vector3d& x,
+                const Eigen::Vector3d& v, std::int32_t near = -1);
+  void add_face(std::int32_t piece, std::int32_t face);
+  void remove_face_from_bullet(std::int32_t face);
+  void remove_face_slot(std::int32_t face);  // out of its body only (no links, no stats)
+  void remove_nodes_highest_first(std::span<const std::int32_t> vertices);
+  /// Moves a whole connected piece (its vertices in Bullet) into a new body, with room for
+  /// `joining` nodes and `added_faces` faces still to come in this change; the body's index.
+  std::int32_t move_to_new_piece(std::span<const std::int32_t> moving, std::int32_t joining,
+                                 std::int32_t added_faces);
+  void remove_link(std::int32_t piece, std::int32_t link);
+  void pop_link(std::int32_t piece, std::int32_t link);  // out of Bullet, key kept
+  void add_link(std::int32_t piece, std::int32_t u, std::int32_t v, double rest);
+  void add_bending(std::int32_t piece, std::int32_t a, std::int32_t b, std::int32_t c,
+                   std::int32_t d, double rest);
+  void remove_bending(std::int32_t a, std::int32_t b);
+  void refresh_bending(std::int32_t a, std::int32_t b);
+  void remove_node(std::int32_t vertex);
+  void detach(std::int32_t vertex);
+  void update_link_constants(std::int32_t vertex);
+  void update_node_area(std::int32_t vertex);
+  bool is_kinematic_by_weight(std::int32_t vertex) const;
+
+  btSoftBodyWorldInfo* info_;
+  std::function<void(btSoftBody*)> add_, remove_;
+  mesh::SkinnedMesh mesh_;
+  mesh::Adjacency adjacency_;
+  // Tear starts and drills query it; synced positions only mark it moved, so its refit is paid
+  // when a tear starts or a drill runs, not every step (face_index.hpp).
+  mesh::FaceIndex face_index_;
+  skin::Skeleton skeleton_;
+  Material material_;
+  std::unique_ptr<mesh::Tear> tear_;
+
+  // Pose source.
+  std::function<void(double, skin::Pose&)> source_;
+  skin::Pose pose_;
+  std::vector<skin::Versor> global_, versors_;
+  std::vector<skin::Kernel34<double>> kernels_;
+  // Skinning inputs/outputs, SoA (see skinning.hpp), rebuilt when vertices are added.
+  skin::SoaPoints<double> rest_soa_, target_, previous_target_;
+  std::vector<std::int32_t> soa_bones_;
+  std::vector<double> soa_weights_;
+  bool fill_previous_ = false;
+  int skin_threads_ = 1;
+
+  // Per vertex.
+  std::vector<std::int32_t> piece_of_, node_of_;
+  std::vector<double> mass_;
+  std::vector<std::uint8_t> kinematic_, pinned_;
+  std::vector<std::vector<std::int32_t>> vertex_faces_;  // incident mesh faces
+  // Per mesh face: the shadow copy of the faces Bullet mirrors, and where each lives.
+  std::vector<mesh::Face> faces_;
+  std::vector<std::int32_t> face_piece_, face_slot_;
+  // Per undirected edge (min, max): faces using it, and its link index in its piece.
+  EdgeTable edge_faces_, edge_link_;
+  // Per undirected edge (min, max) crossed by a bending link: its link index in its piece.
+  EdgeTable bend_link_;
+  // Detached vertices: their position and velocity when they left Bullet.
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> detached_state_;
+  std::vector<std::int32_t> detached_slot_;    // per vertex, −1 unless detached
+  std::vector<std::int32_t> detached_vertex_;  // per slot
+  std::int32_t detached_count_ = 0;
+  // Split search scratch (per vertex, −1 between searches).
+  std::vector<std::int32_t> search_label_;
+  std::vector<std::int32_t> seed_slot_;  // per vertex: its index among a change's seeds (−1)
+  std::vector<std::int32_t> move_slot_;  // per vertex: its node in a new body (−1 between)
+  // Links removed during one change whose link may come back: (a, b, c, d, rest), where (a, b)
+  // is the key edge and (c, d) the end vertices (equal to (a, b) for an edge link).
+  std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, double>> relink_;
+  EdgeTable relink_edge_, relink_bend_;  // key edge → index in relink_
+  void keep_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d, double rest,
+                 bool bending);
+  double kept_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
+                   bool bending) const;
+  void clear_kept();
+  std::vector<std::uint8_t> area_mark_, seed_mark_;  // per vertex scratch, 0 between changes
+  // Edges whose bending link may have to be made again at the end of a change.
+  std::vector<std::pair<std::int32_t, std::int32_t>> bend_dirty_;
+
+  std::vector<std::unique_ptr<Piece>> pieces_;  // null once emptied
+  ApplyStats stats_;
+};
+
+}  // namespace conform::bullet
