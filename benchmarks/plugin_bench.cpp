@@ -236,14 +236,8 @@ BENCHMARK(BM_StepAfterEdit)
 void BM_OpeningTearStep(benchmark::State& state) {
   SoftWorld w;
   bullet::Plugin plugin(w.world);
-  mesh::SkinnedMesh m = mesh::make_sheet(40, 40, 1.0, 1.0);
-  m.bones.setZero();
-  m.weights.setZero();
-  m.weights.row(0).setOnes();
-  skin::Skeleton s;
-  s.joints.push_back({"root", -1, skin::Versor::identity()});
-  s.bones.push_back({"root", 0, skin::Versor::identity()});
-  auto& body = plugin.add_skinned_body(m, s,
+  const mesh::SkinnedMesh m = test::one_bone_sheet(40, 40, 1.0, 1.0);
+  auto& body = plugin.add_skinned_body(m, test::one_bone_skeleton(),
                                        {.damping = 0.05,
                                         .pretension = 0.1,
                                         .target_stiffness = 0,

@@ -352,13 +352,7 @@ TEST(Cut, ReDeformation) {
   // Cut the posed mesh, then re-skin the result with another pose, against skinning the
   // original with that pose and applying the same change.
   const SkinnedMesh original = make_arm(1).mesh;
-  using V = cga::Versor<double>;
-  using M = cga::Motor<double>;
-  const std::vector<V> pose1 = {V::identity(), V::from_motor(M::from_axis_angle({1, 0, 0}, 0.4)),
-                                V{M::from_axis_angle({0, 1, 0}, 0.3), 1.1}};
-  const std::vector<V> pose2 = {V::from_motor(M::from_translation({0.1, 0, 0})),
-                                V::from_motor(M::from_axis_angle({1, 1, 0}, -0.7)),
-                                V{M::from_axis_angle({0, 0, 1}, 0.5), 0.8}};
+  const auto [pose1, pose2] = conform::test::arm_test_poses();
   SkinnedMesh posed = original;
   posed.current = conform::test::reference_lbs(original, pose1);
   for (const double z : {0.12, 0.31, 0.5, 0.58}) {  // upper arm, elbow, forearm/wrist blend, hand

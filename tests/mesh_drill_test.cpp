@@ -471,13 +471,7 @@ TEST(Drill, ReDeformation) {
   // their influences deform exactly as the interpolation of their parents (1e-9); elsewhere
   // LBS of an interpolated point differs from the interpolation by a t(1 − t) term only.
   const SkinnedMesh original = make_arm(1).mesh;
-  using V = conform::cga::Versor<double>;
-  using M = conform::cga::Motor<double>;
-  const std::vector<V> pose1 = {V::identity(), V::from_motor(M::from_axis_angle({1, 0, 0}, 0.4)),
-                                V{M::from_axis_angle({0, 1, 0}, 0.3), 1.1}};
-  const std::vector<V> pose2 = {V::from_motor(M::from_translation({0.1, 0, 0})),
-                                V::from_motor(M::from_axis_angle({1, 1, 0}, -0.7)),
-                                V{M::from_axis_angle({0, 0, 1}, 0.5), 0.8}};
+  const auto [pose1, pose2] = conform::test::arm_test_poses();
   SkinnedMesh posed = original;
   posed.current = conform::test::reference_lbs(original, pose1);
   for (const double z : {0.15, 0.31, 0.42}) {  // upper arm, elbow, forearm

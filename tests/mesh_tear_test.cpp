@@ -181,11 +181,7 @@ TEST(Tear, ReDeformation) {
   // Tear the posed arm across the elbow's blend, then re-skin with another pose, against the
   // original re-skinned with the same changes applied.
   const SkinnedMesh original = make_arm(1).mesh;
-  using V = cga::Versor<double>;
-  using M = cga::Motor<double>;
-  const std::vector<V> pose2 = {V::from_motor(M::from_translation({0.1, 0, 0})),
-                                V::from_motor(M::from_axis_angle({1, 1, 0}, -0.7)),
-                                V{M::from_axis_angle({0, 0, 1}, 0.5), 0.8}};
+  const std::vector<cga::Versor<double>> pose2 = conform::test::arm_test_poses()[1];
   SkinnedMesh a = original;
   Adjacency adj(a);
   Tear tear(a, adj);

@@ -18,18 +18,7 @@ namespace {
 constexpr double kHalf = 0.2;  // the patch spans [−0.2, 0.2]², flat in z = 0
 
 mesh::SkinnedMesh patch(int cells) {
-  mesh::SkinnedMesh m = mesh::make_sheet(cells, cells, 2 * kHalf, 2 * kHalf);
-  m.bones.setZero();
-  m.weights.setZero();
-  m.weights.row(0).setOnes();
-  return m;
-}
-
-skin::Skeleton one_bone() {
-  skin::Skeleton s;
-  s.joints.push_back({"root", -1, skin::Versor::identity()});
-  s.bones.push_back({"root", 0, skin::Versor::identity()});
-  return s;
+  return test::one_bone_sheet(cells, cells, 2 * kHalf, 2 * kHalf);
 }
 
 bullet::Material free_sheet(double bending) {
@@ -48,7 +37,7 @@ double centre_sag(double bending) {
   SoftWorld w(9.81);
   bullet::Plugin plugin(w.world);
   const mesh::SkinnedMesh m = patch(16);
-  auto& body = plugin.add_skinned_body(m, one_bone(), free_sheet(bending));
+  auto& body = plugin.add_skinned_body(m, test::one_bone_skeleton(), free_sheet(bending));
   std::vector<std::int32_t> border;
   std::int32_t centre = -1;
   for (std::int32_t v = 0; v < m.vertex_count(); ++v) {
@@ -82,7 +71,7 @@ TEST(PluginBending, NoBendingLinkCrossesATear) {
   const mesh::SkinnedMesh m = patch(20);
   bullet::Material material = free_sheet(0.5);
   material.pretension = 0.05;
-  auto& body = plugin.add_skinned_body(m, one_bone(), material);
+  auto& body = plugin.add_skinned_body(m, test::one_bone_skeleton(), material);
   std::vector<std::int32_t> border;
   for (std::int32_t v = 0; v < m.vertex_count(); ++v)
     if (std::abs(m.rest(0, v)) > kHalf - 1e-9 || std::abs(m.rest(1, v)) > kHalf - 1e-9)

@@ -50,18 +50,7 @@ void fit_ellipse(Profile& p) {
 }
 
 mesh::SkinnedMesh patch() {
-  mesh::SkinnedMesh m = mesh::make_sheet(40, 40, 2 * kHalf, 2 * kHalf);
-  m.bones.setZero();
-  m.weights.setZero();
-  m.weights.row(0).setOnes();  // one bone: the whole patch rides the identity pose
-  return m;
-}
-
-skin::Skeleton one_bone() {
-  skin::Skeleton s;
-  s.joints.push_back({"root", -1, skin::Versor::identity()});
-  s.bones.push_back({"root", 0, skin::Versor::identity()});
-  return s;
+  return test::one_bone_sheet(40, 40, 2 * kHalf, 2 * kHalf);
 }
 
 // Tears the patch along y = kTearY, lets it settle, and returns the opening profile.
@@ -74,7 +63,7 @@ Profile tear_and_settle(double pretension, SoftWorld& w, bullet::Plugin& plugin)
   material.target_damping = 0;
   material.damping = 0.05;
   material.position_iterations = 10;
-  auto& body = plugin.add_skinned_body(m, one_bone(), material);
+  auto& body = plugin.add_skinned_body(m, test::one_bone_skeleton(), material);
   std::vector<std::int32_t> border;
   for (std::int32_t v = 0; v < m.vertex_count(); ++v)
     if (std::abs(m.rest(0, v)) > kHalf - 1e-9 || std::abs(m.rest(1, v)) > kHalf - 1e-9)

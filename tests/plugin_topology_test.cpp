@@ -386,14 +386,9 @@ mesh::TopologyChange remove_faces_where(const mesh::SkinnedMesh& m, Predicate re
 TEST(PluginTopology, SplitSearchStaysLocalForHolesAndFindsEverySplit) {
   SoftWorld w;
   bullet::Plugin plugin(w.world);
-  mesh::SkinnedMesh sheet = mesh::make_sheet(40, 40, 1.0, 1.0);
-  sheet.bones.setZero();
-  sheet.weights.setZero();
-  sheet.weights.row(0).setOnes();
-  skin::Skeleton s;
-  s.joints.push_back({"root", -1, skin::Versor::identity()});
-  s.bones.push_back({"root", 0, skin::Versor::identity()});
-  auto& body = plugin.add_skinned_body(sheet, s, {.pretension = 0.1, .kinematic_weight = 2});
+  const mesh::SkinnedMesh sheet = test::one_bone_sheet(40, 40, 1.0, 1.0);
+  auto& body = plugin.add_skinned_body(sheet, test::one_bone_skeleton(),
+                                       {.pretension = 0.1, .kinematic_weight = 2});
   w.step(3);
   auto near = [](double x, double y, double r) {
     return [=](const Eigen::Vector3d& c) { return std::hypot(c.x() - x, c.y() - y) < r; };

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "conform/bullet/skinned_soft_body.hpp"
+#include "conform/mesh/primitives.hpp"
 #include "conform/skin/pose.hpp"
 
 namespace conform::test {
@@ -35,6 +36,23 @@ struct SoftWorld {
     for (int i = 0; i < n; ++i) world.stepSimulation(btScalar(dt), 1, btScalar(dt));
   }
 };
+
+/// A flat sheet (see mesh::make_sheet) skinned wholly to bone 0: it rides the identity pose.
+inline mesh::SkinnedMesh one_bone_sheet(int cells_x, int cells_y, double width, double height) {
+  mesh::SkinnedMesh m = mesh::make_sheet(cells_x, cells_y, width, height);
+  m.bones.setZero();
+  m.weights.setZero();
+  m.weights.row(0).setOnes();
+  return m;
+}
+
+/// A skeleton of one bone at the origin, for one_bone_sheet.
+inline skin::Skeleton one_bone_skeleton() {
+  skin::Skeleton s;
+  s.joints.push_back({"root", -1, skin::Versor::identity()});
+  s.bones.push_back({"root", 0, skin::Versor::identity()});
+  return s;
+}
 
 /// The arm's rest pose with the shoulder turned about y and the elbow bent about x (radians).
 inline skin::Pose bent_arm_pose(const skin::Skeleton& skeleton, double shoulder, double elbow) {

@@ -4,8 +4,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
+#include "conform/cga/motor.hpp"
 #include "conform/cga/versor.hpp"
 #include "conform/mesh/skinned_mesh.hpp"
 
@@ -22,6 +24,19 @@ inline Eigen::Matrix3Xd reference_lbs(const mesh::SkinnedMesh& m,
     out.col(v) = x;
   }
   return out;
+}
+
+/// Two poses of the procedural arm's three bones for the re-deformation tests: the first to
+/// pose the arm before a change, the second to re-skin after it (rotations about several axes,
+/// a translation, and dilations 1.1 and 0.8, so that every part of the versor counts).
+inline std::array<std::vector<cga::Versor<double>>, 2> arm_test_poses() {
+  using V = cga::Versor<double>;
+  using M = cga::Motor<double>;
+  return {{{V::identity(), V::from_motor(M::from_axis_angle({1, 0, 0}, 0.4)),
+            V{M::from_axis_angle({0, 1, 0}, 0.3), 1.1}},
+           {V::from_motor(M::from_translation({0.1, 0, 0})),
+            V::from_motor(M::from_axis_angle({1, 1, 0}, -0.7)),
+            V{M::from_axis_angle({0, 0, 1}, 0.5), 0.8}}}};
 }
 
 }  // namespace conform::test
