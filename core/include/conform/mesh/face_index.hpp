@@ -3,9 +3,9 @@
 // of every face.
 //
 // Why a BVH and not a uniform grid: the meshes it serves are far from uniform (the arm's
-// rounded caps and the drill's 1-to-4 refinements make faces of very different sizes, a sheet
-// is flat, a sphere is hollow), and they move every step. A BVH adapts to the face sizes, its
-// refit after a motion is one bottom-up pass that never changes its structure (a grid has to
+// rounded caps and the drill's refinement near its rims make faces of very different sizes,
+// a sheet is flat, a sphere is hollow), and they move every step. A BVH adapts to the face sizes,
+// its refit after a motion is one bottom-up pass that never changes its structure (a grid has to
 // re-bin every face, and its cell size and extent go stale as the mesh moves or deforms), and
 // faces can be inserted and removed locally. Leaves hold up to 8 faces (4 after a build); boxes
 // are floats padded by more than their rounding, so a box test never rejects a face that the
@@ -83,7 +83,7 @@ class FaceIndex {
   /// change was not computed for the mesh this index describes.
   void update(const SkinnedMesh& mesh, const TopologyChange& change);
   /// Between begin_batch() and end_batch(mesh), update() defers its insertions: an operation
-  /// that applies several changes in a row (the drill's refinements, then its hole) inserts
+  /// that applies several changes in a row (the drill's hole, then its tube walls) inserts
   /// only the faces that survive them all. No queries (and no validate) inside a batch.
   void begin_batch() { batch_ = true; }
   void end_batch(const SkinnedMesh& mesh);
