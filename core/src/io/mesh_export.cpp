@@ -88,7 +88,7 @@ void add(std::string& out, double v, bool space = true) {
 }
 
 std::string encode(const mesh::SkinnedMesh& mesh, const Selection& s, const MeshExportOptions& o) {
-  const Eigen::Matrix3Xd& pos = o.rest_positions ? mesh.rest : mesh.current;
+  const auto& pos = o.rest_positions ? mesh.rest : mesh.current;
   if (pos.cols() != mesh.vertex_count())
     throw std::runtime_error("mesh export: position matrix does not match the vertex count");
   const bool uvs = o.uvs && mesh.has_uvs();

@@ -27,7 +27,7 @@ const char* skin_mode_name(SkinMode mode) {
 }
 
 template <class T>
-Skinner<T>::Skinner(const Skeleton& skeleton, const Eigen::Matrix3Xd& rest,
+Skinner<T>::Skinner(const Skeleton& skeleton, Eigen::Ref<const Eigen::Matrix3Xd> rest,
                     const InfluenceLists& influences, int max_influences)
     : skeleton_(&skeleton),
       rest_(SoaPoints<T>::from(rest)),

@@ -95,7 +95,7 @@ Influences<T> Influences<T>::select(const InfluenceLists& lists, int k) {
 }
 
 template <class T>
-SoaPoints<T> SoaPoints<T>::from(const Eigen::Matrix3Xd& p) {
+SoaPoints<T> SoaPoints<T>::from(Eigen::Ref<const Eigen::Matrix3Xd> p) {
   SoaPoints s;
   s.resize(static_cast<std::size_t>(p.cols()));
   for (Eigen::Index i = 0; i < p.cols(); ++i) {
@@ -104,16 +104,6 @@ SoaPoints<T> SoaPoints<T>::from(const Eigen::Matrix3Xd& p) {
     s.z[u] = static_cast<T>(p(2, i));
   }
   return s;
-}
-
-template <class T>
-void SoaPoints<T>::to(Eigen::Matrix3Xd& p) const {
-  const auto n = static_cast<Eigen::Index>(x.size());
-  if (p.cols() != n) p.resize(3, n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    const auto u = static_cast<std::size_t>(i);
-    p(0, i) = x[u], p(1, i) = y[u], p(2, i) = z[u];
-  }
 }
 
 template <class T>

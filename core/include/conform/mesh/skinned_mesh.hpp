@@ -16,6 +16,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "conform/mesh/column_array.hpp"
+
 namespace conform::mesh {
 
 inline constexpr int kMaxInfluences = 4;
@@ -23,13 +25,15 @@ inline constexpr int kMaxInfluences = 4;
 using Face = std::array<std::int32_t, 3>;
 
 struct SkinnedMesh {
-  Eigen::Matrix3Xd rest;
-  Eigen::Matrix3Xd current;
+  // Per-vertex fields keep spare capacity (column_array.hpp): appending vertices is amortized
+  // O(added), not a copy of every column.
+  ColumnArray<double, 3> rest;
+  ColumnArray<double, 3> current;
   std::vector<Face> faces;
-  Eigen::Matrix<std::int32_t, kMaxInfluences, Eigen::Dynamic> bones;
-  Eigen::Matrix<double, kMaxInfluences, Eigen::Dynamic> weights;
-  Eigen::Matrix2Xd uvs;
-  Eigen::Matrix3Xd normals;
+  ColumnArray<std::int32_t, kMaxInfluences> bones;
+  ColumnArray<double, kMaxInfluences> weights;
+  ColumnArray<double, 2> uvs;
+  ColumnArray<double, 3> normals;
 
   std::int32_t vertex_count() const { return static_cast<std::int32_t>(rest.cols()); }
   std::int32_t face_count() const { return static_cast<std::int32_t>(faces.size()); }

@@ -28,8 +28,8 @@ class Skinner {
  public:
   /// `skeleton` must outlive the skinner. Uses each vertex's `max_influences` largest
   /// influences, renormalized. Throws std::invalid_argument on inconsistent sizes or bone ids.
-  Skinner(const Skeleton& skeleton, const Eigen::Matrix3Xd& rest, const InfluenceLists& influences,
-          int max_influences = mesh::kMaxInfluences);
+  Skinner(const Skeleton& skeleton, Eigen::Ref<const Eigen::Matrix3Xd> rest,
+          const InfluenceLists& influences, int max_influences = mesh::kMaxInfluences);
 
   /// Poses the mesh: per-bone coefficients for `mode` from `pose`, then the vertex loop.
   void skin(const Pose& pose, SkinMode mode);
@@ -40,7 +40,11 @@ class Skinner {
 
   void set_threads(int threads) { threads_ = threads; }
   const SoaPoints<T>& output() const { return out_; }
-  void write(Eigen::Matrix3Xd& points) const { out_.to(points); }
+  /// Writes the skinned points (into an Eigen::Matrix3Xd or a mesh's ColumnArray).
+  template <class Columns>
+  void write(Columns& points) const {
+    out_.to(points);
+  }
   std::span<const Versor> skinning_versors() const { return skin_versors_; }
   const Influences<T>& influences() const { return influences_; }
   std::size_t vertex_count() const { return rest_.size(); }

@@ -63,11 +63,20 @@ template <class T>
 struct SoaPoints {
   std::vector<T> x, y, z;
 
-  static SoaPoints from(const Eigen::Matrix3Xd& points);
+  static SoaPoints from(Eigen::Ref<const Eigen::Matrix3Xd> points);
   void resize(std::size_t n) { x.resize(n), y.resize(n), z.resize(n); }
   std::size_t size() const { return x.size(); }
-  /// Writes the points into a 3 × n matrix (resized if needed).
-  void to(Eigen::Matrix3Xd& points) const;
+  /// Writes the points into a 3 × n matrix (an Eigen::Matrix3Xd or a mesh's ColumnArray,
+  /// resized if needed).
+  template <class Columns>
+  void to(Columns& points) const {
+    const auto n = static_cast<Eigen::Index>(x.size());
+    if (points.cols() != n) points.resize(3, n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const auto u = static_cast<std::size_t>(i);
+      points(0, i) = x[u], points(1, i) = y[u], points(2, i) = z[u];
+    }
+  }
 };
 
 /// Row-major 3×4 [A | b]: x' = A x + b.
