@@ -16,7 +16,6 @@
 #include "conform/mesh/adjacency.hpp"
 #include "conform/mesh/face_index.hpp"
 #include "conform/skin/skinning.hpp"
-#include "edge_table.hpp"
 
 namespace conform::bullet {
 
@@ -144,9 +143,9 @@ struct SkinnedSoftBody::Impl {
   std::vector<mesh::Face> faces_;
   std::vector<std::int32_t> face_piece_, face_slot_;
   // Per undirected edge (min, max): faces using it, and its link index in its piece.
-  EdgeTable edge_faces_, edge_link_;
+  mesh::EdgeMap edge_faces_, edge_link_;
   // Per undirected edge (min, max) crossed by a bending link: its link index in its piece.
-  EdgeTable bend_link_;
+  mesh::EdgeMap bend_link_;
   // Detached vertices: their position and velocity when they left Bullet.
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> detached_state_;
   std::vector<std::int32_t> detached_slot_;    // per vertex, −1 unless detached
@@ -159,7 +158,7 @@ struct SkinnedSoftBody::Impl {
   // Links removed during one change whose link may come back: (a, b, c, d, rest), where (a, b)
   // is the key edge and (c, d) the end vertices (equal to (a, b) for an edge link).
   std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, double>> relink_;
-  EdgeTable relink_edge_, relink_bend_;  // key edge → index in relink_
+  mesh::EdgeMap relink_edge_, relink_bend_;  // key edge → index in relink_
   void keep_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d, double rest,
                  bool bending);
   double kept_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,

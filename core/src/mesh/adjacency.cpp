@@ -1,83 +1,55 @@
 #include "conform/mesh/adjacency.hpp"
 
+#include <bit>
+
 namespace conform::mesh {
 
 void EdgeMap::clear() {
   slots_.clear();
-  size_ = used_ = 0;
+  size_ = mask_ = 0;
+  shift_ = 64;
 }
 
 void EdgeMap::rehash(std::size_t capacity) {
   std::vector<Slot> old = std::move(slots_);
   slots_.assign(capacity, Slot{kEmpty, kNone});
-  size_ = used_ = 0;
+  mask_ = capacity - 1;
+  shift_ = 64 - std::countr_zero(capacity);
+  size_ = 0;
   for (const Slot& o : old)
-    if (o.key != kEmpty && o.key != kTomb) {
-      slots_[slot(o.key)] = o;
-      ++size_, ++used_;
+    if (o.key != kEmpty) {
+      std::size_t s = home(o.key);
+      while (slots_[s].key != kEmpty) s = (s + 1) & mask_;
+      slots_[s] = o;
+      ++size_;
     }
 }
 
 void EdgeMap::reserve(std::size_t count) {
-  std::size_t cap = 16;
-  while (cap < 2 * count) cap *= 2;
-  if (cap > slots_.size()) rehash(cap);
-}
-
-void EdgeMap::grow() {
-  // Double when live entries fill half the table, else only drop the tombstones.
-  if (slots_.empty()) return rehash(16);
-  rehash(2 * size_ + 2 > slots_.size() / 2 ? 2 * slots_.size() : slots_.size());
-}
-
-// Home slots take bits 32 and up of the multiplicative hash: they depend on both vertices of
-// the key (bits below 32 would see only the second one, so that keys sharing it — (v, 0) in
-// the cut's loop maps, or a vertex's fan here — would pile up in one probe run).
-//
-// The slot holding k, or the first empty slot of its probe sequence.
-std::size_t EdgeMap::slot(std::uint64_t k) const {
-  const std::size_t mask = slots_.size() - 1;
-  std::size_t s = std::size_t(k * 0x9E3779B97F4A7C15ull >> 32) & mask;
-  while (slots_[s].key != kEmpty && slots_[s].key != k) s = (s + 1) & mask;
-  return s;
-}
-
-std::int32_t EdgeMap::find(std::int32_t u, std::int32_t v) const {
-  if (slots_.empty()) return kNone;
-  const Slot& s = slots_[slot(key(u, v))];
-  return s.key == kEmpty ? kNone : s.value;
-}
-
-bool EdgeMap::insert(std::int32_t u, std::int32_t v, std::int32_t value, bool overwrite) {
-  if (slots_.empty() || 4 * (used_ + 1) > 3 * slots_.size()) grow();
-  const std::uint64_t k = key(u, v);
-  const std::size_t mask = slots_.size() - 1;
-  std::size_t s = std::size_t(k * 0x9E3779B97F4A7C15ull >> 32) & mask;
-  std::size_t tomb = slots_.size();
-  while (slots_[s].key != kEmpty && slots_[s].key != k) {
-    if (slots_[s].key == kTomb && tomb == slots_.size()) tomb = s;
-    s = (s + 1) & mask;
-  }
-  if (slots_[s].key == k) {
-    if (!overwrite) return false;
-    slots_[s].value = value;
-    return true;
-  }
-  if (tomb != slots_.size()) {
-    s = tomb;
-  } else {
-    ++used_;
-  }
-  slots_[s] = {k, value};
-  ++size_;
-  return true;
+  std::size_t capacity = 16;
+  while (capacity < 2 * count) capacity *= 2;
+  if (capacity > slots_.size()) rehash(capacity);
 }
 
 void EdgeMap::erase(std::int32_t u, std::int32_t v, std::int32_t value) {
   if (slots_.empty()) return;
-  Slot& s = slots_[slot(key(u, v))];
-  if (s.key == kEmpty || s.value != value) return;
-  s = {kTomb, kNone};
+  const std::uint64_t k = key(u, v);
+  std::size_t hole = home(k);
+  while (slots_[hole].key != k) {
+    if (slots_[hole].key == kEmpty) return;
+    hole = (hole + 1) & mask_;
+  }
+  if (slots_[hole].value != value) return;
+  // Shift back every later entry of the run that may live in the hole: one whose home is not
+  // cyclically within (hole, j] (its distance from home is at least the hole's distance).
+  for (std::size_t j = (hole + 1) & mask_; slots_[j].key != kEmpty; j = (j + 1) & mask_) {
+    const std::size_t h = home(slots_[j].key);
+    if (((j - h) & mask_) >= ((j - hole) & mask_)) {
+      slots_[hole] = slots_[j];
+      hole = j;
+    }
+  }
+  slots_[hole] = {kEmpty, kNone};
   --size_;
 }
 

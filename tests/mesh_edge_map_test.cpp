@@ -1,7 +1,8 @@
-// EdgeTable (the plugin's per-edge books) against std::map under random inserts, overwrites,
-// counted updates and erasures, including erasures with stale values and runs that wrap around
-// the end of the table (backward-shift deletion must keep every remaining key findable).
-#include "edge_table.hpp"
+// EdgeMap (the adjacency's half-edges, the plugin's per-edge books) against std::map under
+// random inserts, overwrites, counted updates and erasures, including erasures with stale values
+// and runs that wrap around the end of the table (backward-shift deletion must keep every
+// remaining key findable).
+#include "conform/mesh/adjacency.hpp"
 
 #include <gtest/gtest.h>
 
@@ -10,36 +11,36 @@
 #include <random>
 #include <utility>
 
-using conform::bullet::EdgeTable;
+using conform::mesh::EdgeMap;
 
-TEST(PluginEdgeTable, EmptyFindsNothingAndErasesNothing) {
-  EdgeTable t;
-  EXPECT_EQ(t.find(1, 2), EdgeTable::kNone);
+TEST(EdgeMap, EmptyFindsNothingAndErasesNothing) {
+  EdgeMap t;
+  EXPECT_EQ(t.find(1, 2), EdgeMap::kNone);
   t.erase(1, 2, 0);
   EXPECT_EQ(t.size(), 0u);
 }
 
-TEST(PluginEdgeTable, InsertKeepsOrOverwritesAndAtCounts) {
-  EdgeTable t;
+TEST(EdgeMap, InsertKeepsOrOverwritesAndAtCounts) {
+  EdgeMap t;
   EXPECT_TRUE(t.insert(3, 4, 7));
   EXPECT_FALSE(t.insert(3, 4, 8));
   EXPECT_EQ(t.find(3, 4), 7);
   EXPECT_TRUE(t.insert(3, 4, 8, true));
   EXPECT_EQ(t.find(3, 4), 8);
-  EXPECT_EQ(t.find(4, 3), EdgeTable::kNone);  // directed keys
+  EXPECT_EQ(t.find(4, 3), EdgeMap::kNone);  // directed keys
   ++t.at(5, 6, 0);
   ++t.at(5, 6, 0);
   EXPECT_EQ(t.find(5, 6), 2);
   t.erase(5, 6, 1);  // stale value: kept
   EXPECT_EQ(t.find(5, 6), 2);
   t.erase(5, 6, 2);
-  EXPECT_EQ(t.find(5, 6), EdgeTable::kNone);
+  EXPECT_EQ(t.find(5, 6), EdgeMap::kNone);
   EXPECT_EQ(t.size(), 1u);
 }
 
-TEST(PluginEdgeTable, MatchesAMapUnderRandomEdits) {
+TEST(EdgeMap, MatchesAMapUnderRandomEdits) {
   for (const int range : {8, 60, 3000}) {  // dense keys (long runs, wrap-around) to sparse
-    EdgeTable t;
+    EdgeMap t;
     std::map<std::pair<int, int>, int> ref;
     std::mt19937 rng{std::uint32_t(range)};
     for (int step = 0; step < 40000; ++step) {
@@ -78,7 +79,7 @@ TEST(PluginEdgeTable, MatchesAMapUnderRandomEdits) {
     for (int u = 0; u < std::min(range, 60); ++u) {
       for (int v = 0; v < std::min(range, 60); ++v) {
         auto it = ref.find({u, v});
-        ASSERT_EQ(t.find(u, v), it == ref.end() ? EdgeTable::kNone : it->second);
+        ASSERT_EQ(t.find(u, v), it == ref.end() ? EdgeMap::kNone : it->second);
       }
     }
   }
