@@ -247,6 +247,7 @@ class Region {
     std::int32_t index = -1;  // in the mesh: original vertices from the start, new ones on emit
     int side = 1;             // +1 outside, −1 inside, 0 on the cylinder (snapped)
     bool rim = false;         // a new vertex on the cylinder
+    bool loop = false;        // on a rim loop kept for the tube
   };
   struct LocalFace {
     std::array<std::int32_t, 3> v;
@@ -268,7 +269,7 @@ class Region {
     verts.clear(), faces.clear(), origins.clear(), touched.clear();
     vertex_of_.clear(), face_of_.clear(), pending_.clear();
     work.clear(), fate.clear(), added.clear(), hole_edges.clear();
-    crossing_vertex.clear(), next.clear();
+    crossing_vertex.clear(), next.clear(), rim_edges.clear(), new_x.clear();
   }
 
   std::vector<Vertex> verts;
@@ -498,7 +499,8 @@ class Region {
   std::vector<std::uint8_t> fate;
   std::vector<Face> added;
   std::vector<std::array<std::int32_t, 3>> hole_edges;
-  FlatMap crossing_vertex{64}, next{64};
+  FlatMap crossing_vertex{64}, next{64}, rim_edges{64}, in_a{64};
+  std::vector<Eigen::Vector3d> new_x;
 
  private:
   void link(std::int32_t h, std::int32_t t) {
@@ -517,26 +519,42 @@ class Region {
   FlatMap vertex_of_{256}, face_of_{128}, pending_{128};
 };
 
-// Joins consecutive holes along the axis, where the drill enters then leaves the surface, with
-// a strip of triangles between their rim loops (see drill.hpp, step 6), through `rings`
-// intermediate rings when ring_spacing > 0.
-template <class Commit>
-void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis& axis,
-                const std::vector<Patch>& patches, double ring_spacing, DrillResult& result,
-                Commit& commit) {
+// The post-change mesh, seen from the drill's change before it is applied: positions of old and
+// new vertices, and whether a directed edge between two rim vertices will exist.
+struct Outcome {
+  const SkinnedMesh& mesh;
+  const Adjacency& adjacency;
+  const TopologyChange& change;
+  const std::vector<Eigen::Vector3d>& new_x;  // positions of change.new_vertices
+  const FlatMap& rim_edges;  // directed edges of the change's added faces between rim vertices
+  Eigen::Vector3d pos(std::int32_t v) const {
+    return v < change.base_vertex_count ? Eigen::Vector3d(mesh.current.col(v))
+                                        : new_x[std::size_t(v - change.base_vertex_count)];
+  }
+  // x → y is a half-edge of the changed mesh: of an added face, or of an original face that
+  // the change keeps.
+  bool has(std::int32_t x, std::int32_t y) const {
+    if (rim_edges.find(FlatMap::pair(x, y)) >= 0) return true;
+    if (x >= change.base_vertex_count || y >= change.base_vertex_count) return false;
+    const std::int32_t h = adjacency.find(x, y);
+    return h >= 0 &&
+           !std::binary_search(change.removed_faces.begin(), change.removed_faces.end(), h / 3);
+  }
+};
+
+// Appends to `change` the tube walls joining consecutive holes along the axis, where the drill
+// enters then leaves the surface (see drill.hpp, step 6): a strip of triangles between their
+// rim loops, through intermediate rings of new vertices when ring_spacing > 0. Everything is
+// decided on the change before it is applied (Outcome), so that the drill applies one change.
+void add_tubes(const Outcome& out, const Axis& axis, const std::vector<Patch>& patches,
+               double ring_spacing, TopologyChange& change, std::vector<Eigen::Vector3d>& new_x,
+               FlatMap& rim_edges, FlatMap& in_a, DrillResult& result) {
   std::vector<const Patch*> cut;
   for (const auto& p : patches)
     if (p.cut) cut.push_back(&p);
   std::sort(cut.begin(), cut.end(), [](const Patch* a, const Patch* b) { return a->t < b->t; });
-  // Ring vertices (not in the mesh yet): (1 − s) a + s b of two rim vertices.
-  std::int32_t nv = mesh.vertex_count();  // the mesh's, as each tube is made
-  std::vector<NewVertex> ring_vertices;
-  auto pos = [&](std::int32_t v) -> Eigen::Vector3d {
-    if (v < nv) return mesh.current.col(v);
-    const NewVertex& r = ring_vertices[std::size_t(v - nv)];
-    return r.coefficients[0] * mesh.current.col(r.parents[0]) +
-           r.coefficients[1] * mesh.current.col(r.parents[1]);
-  };
+  const std::int32_t nv0 = change.base_vertex_count;
+  auto pos = [&](std::int32_t v) { return out.pos(v); };
   // The rim vertices' angles about the axis, in the frame of Π.
   auto angle = [&](std::int32_t v) {
     const Eigen::Vector2d q = axis.project(pos(v));
@@ -547,22 +565,38 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
   // Cumulative turning along a closed loop from its first vertex (loop.size() + 1 values).
   auto turning = [&](const std::vector<std::int32_t>& loop) {
     std::vector<double> cum(loop.size() + 1, 0.0);
-    for (std::size_t k = 0; k < loop.size(); ++k)
-      cum[k + 1] = cum[k] + wrap(angle(loop[(k + 1) % loop.size()]) - angle(loop[k]));
+    double previous = angle(loop[0]), first = previous;
+    for (std::size_t k = 0; k < loop.size(); ++k) {
+      const double next = k + 1 < loop.size() ? angle(loop[k + 1]) : first;
+      cum[k + 1] = cum[k] + wrap(next - previous);
+      previous = next;
+    }
     return cum;
   };
   // Both loops wind once about the axis the same way.
   auto winds_with = [&](const std::vector<double>& a, const std::vector<double>& b) {
     return std::abs(std::abs(a.back()) - 2 * pi) <= 1e-6 && std::abs(a.back() - b.back()) <= 1e-6;
   };
+  // The winding number of a loop of positions about the axis (crossings of the ray along e1,
+  // signed): no trigonometry, for the rings.
+  auto winding = [&](const std::vector<Eigen::Vector2d>& q) {
+    int w = 0;
+    for (std::size_t k = 0; k < q.size(); ++k) {
+      const Eigen::Vector2d &p0 = q[k], &p1 = q[(k + 1) % q.size()];
+      const double cross = p0.x() * p1.y() - p0.y() * p1.x();
+      if (p0.y() <= 0 && p1.y() > 0 && cross > 0) ++w;
+      if (p1.y() <= 0 && p0.y() > 0 && cross < 0) --w;
+    }
+    return w;
+  };
   auto fail = [&](const std::string& why) {
     if (!result.message.empty()) result.message += "; ";
     result.message += why;
   };
   // The strip between loops P and Q (Q[0] the nearest of Q to P[0] in angle), merged by angle.
-  auto zip = [&](const std::vector<std::int32_t>& P, const std::vector<std::int32_t>& Q,
+  auto zip = [&](const std::vector<std::int32_t>& P, const std::vector<double>& alpha,
+                 const std::vector<std::int32_t>& Q, const std::vector<double>& beta,
                  std::vector<Face>& faces) {
-    const std::vector<double> alpha = turning(P), beta = turning(Q);
     const double sign = alpha.back() > 0 ? 1 : -1, delta = wrap(angle(Q[0]) - angle(P[0]));
     const std::size_t n = P.size(), m = Q.size();
     for (std::size_t ia = 0, jb = 0; ia < n || jb < m;) {
@@ -577,6 +611,20 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
       }
     }
   };
+  // The strip between two rings of equal size whose k-th vertices correspond (on one segment
+  // between the rims): quads, each split along its shorter diagonal.
+  auto ladder = [&](const std::vector<std::int32_t>& P, const std::vector<std::int32_t>& Q,
+                    std::vector<Face>& faces) {
+    const std::size_t n = P.size();
+    for (std::size_t k = 0; k < n; ++k) {
+      const std::int32_t p0 = P[k], p1 = P[(k + 1) % n], q0 = Q[k], q1 = Q[(k + 1) % n];
+      if ((pos(p1) - pos(q0)).squaredNorm() <= (pos(p0) - pos(q1)).squaredNorm())
+        faces.push_back({p0, p1, q0}), faces.push_back({q1, q0, p1});
+      else
+        faces.push_back({p0, p1, q1}), faces.push_back({q1, q0, p0});
+    }
+  };
+  std::vector<Face> faces;
   for (std::size_t i = 0; i + 1 < cut.size();) {
     const Patch& pa = *cut[i];
     const Patch& pb = *cut[i + 1];
@@ -585,8 +633,6 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
       continue;
     }
     i += 2;
-    nv = mesh.vertex_count();
-    ring_vertices.clear();
     if (pa.rim.empty() || pb.rim.empty()) {
       fail("tube: a rim is not one simple loop of rim vertices");
       continue;
@@ -605,14 +651,23 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
       fail("tube: the rims do not wind once around the axis in matching directions");
       continue;
     }
+    // The tube must only add edges: the rims share no vertex; along the rims the strip uses
+    // the reverse of a boundary half-edge (checked below), and across it edges that the
+    // changed mesh does not have (ring vertices are new: no edge has them).
+    bool ok = true;
+    in_a.clear();
+    for (auto v : A) in_a.insert(std::uint64_t(v), 1);
+    for (auto v : B) ok = ok && in_a.find(std::uint64_t(v)) < 0;
     // Rings: each rim vertex's partner on the other rim is the one nearest in turning; ring k
     // of K lies at s = k / (K + 1) on the segments from the nearer rim's vertices to their
     // partners, so that it has that rim's spacing. K makes the rings at most ring_spacing ×
     // the rims' mean edge apart (without them one triangle spans the whole wall).
     const double sign = alpha.back() > 0 ? 1 : -1, delta = wrap(angle(B[0]) - a0);
     const std::size_t n = A.size(), m = B.size();
+    const std::size_t first_ring = change.new_vertices.size();
     std::vector<std::vector<std::int32_t>> loops{A};
-    if (ring_spacing > 0) {
+    std::size_t a_family = 1;  // loops[0, a_family) have A's size and correspondence
+    if (ok && ring_spacing > 0) {
       std::vector<std::size_t> partner_a(n), partner_b(m);
       for (std::size_t ia = 0, jb = 0; ia < n; ++ia) {
         while (jb + 1 < m && std::abs(sign * (delta + beta[jb + 1]) - sign * alpha[ia]) <
@@ -634,55 +689,67 @@ void join_holes(const SkinnedMesh& mesh, const Adjacency& adjacency, const Axis&
       for (std::size_t k = 0; k < m; ++k) rims += (pos(B[(k + 1) % m]) - pos(B[k])).norm();
       const double step = ring_spacing * rims / double(n + m);
       const int rings = std::min(64, std::max(0, int(std::ceil(across / step)) - 1));
+      std::vector<Eigen::Vector2d> q;
       for (int r = 1; r <= rings; ++r) {
         const double s = double(r) / (rings + 1);
+        const bool from_a = s <= 0.5;
         std::vector<std::int32_t> ring;
-        if (s <= 0.5)
-          for (std::size_t k = 0; k < n; ++k) {
-            ring.push_back(nv + std::int32_t(ring_vertices.size()));
-            ring_vertices.push_back(NewVertex::on_edge(A[k], B[partner_a[k]], s));
-          }
-        else
-          for (std::size_t k = 0; k < m; ++k) {
-            ring.push_back(nv + std::int32_t(ring_vertices.size()));
-            ring_vertices.push_back(NewVertex::on_edge(A[partner_b[k]], B[k], s));
-          }
-        if (!winds_with(alpha, turning(ring))) {  // a ring folds back: no rings for this tube
-          ring_vertices.clear();
+        q.clear();
+        for (std::size_t k = 0; k < (from_a ? n : m); ++k) {
+          const std::int32_t a = from_a ? A[k] : A[partner_b[k]];
+          const std::int32_t b = from_a ? B[partner_a[k]] : B[k];
+          ring.push_back(nv0 + std::int32_t(change.new_vertices.size()));
+          change.new_vertices.push_back(NewVertex::on_edge(a, b, s));
+          new_x.push_back((1 - s) * pos(a) + s * pos(b));
+          q.push_back(axis.project(new_x.back()));
+        }
+        if (winding(q) != int(sign)) {  // a ring folds back: no rings for this tube
+          change.new_vertices.resize(first_ring);
+          new_x.resize(first_ring);
           loops.resize(1);
+          a_family = 1;
           break;
         }
         loops.push_back(std::move(ring));
+        if (from_a) a_family = loops.size();
       }
     }
     loops.push_back(B);
-    std::vector<Face> faces;
-    for (std::size_t k = 0; k + 1 < loops.size(); ++k) zip(loops[k], loops[k + 1], faces);
-    // The strip must only add edges: along the rims the reverse of a boundary half-edge, across
-    // the tube edges that do not exist yet (ring vertices are new: no edge has them).
-    EdgeMap in_a;
-    for (auto v : A) in_a.insert(0, v, 1);
-    bool ok = true;
-    for (auto v : B) ok = ok && in_a.find(0, v) < 0;
-    for (const Face& f : faces)
+    const std::size_t first_face = faces.size();
+    for (std::size_t k = 0; ok && k + 1 < loops.size(); ++k) {
+      if (k + 1 < a_family || k >= a_family) {
+        ladder(loops[k], loops[k + 1], faces);
+        continue;
+      }
+      // Between the last ring of A's spacing and the first of B's: merged by angle.
+      const auto& P = loops[k];
+      const auto& Q = loops[k + 1];
+      zip(P, k == 0 ? alpha : turning(P), Q, k + 2 == loops.size() ? beta : turning(Q), faces);
+    }
+    for (std::size_t f = first_face; f < faces.size() && ok; ++f)
       for (int e = 0; e < 3 && ok; ++e) {
-        const std::int32_t x = f[e], y = f[(e + 1) % 3];
-        const bool across = (in_a.find(0, x) >= 0) != (in_a.find(0, y) >= 0);
-        ok = adjacency.find(x, y) < 0 && (!across || adjacency.find(y, x) < 0);
+        const std::int32_t x = faces[f][e], y = faces[f][(e + 1) % 3];
+        if (x >= nv0 + std::int32_t(first_ring) || y >= nv0 + std::int32_t(first_ring))
+          continue;  // a ring vertex: a new edge
+        const bool across =
+            (in_a.find(std::uint64_t(x)) >= 0) != (in_a.find(std::uint64_t(y)) >= 0);
+        ok = !out.has(x, y) && (!across || !out.has(y, x));
       }
     if (!ok) {
+      faces.resize(first_face);
+      change.new_vertices.resize(first_ring);
+      new_x.resize(first_ring);
       fail("tube: the rims share vertices or edges");
       continue;
     }
-    TopologyChange tube;
-    tube.base_vertex_count = nv;
-    tube.base_face_count = mesh.face_count();
-    tube.new_vertices = std::move(ring_vertices);
-    tube.added_faces = std::move(faces);
-    result.tube_faces += static_cast<std::int32_t>(tube.added_faces.size());
+    // Later tubes see this one's edges.
+    for (std::size_t f = first_face; f < faces.size(); ++f)
+      for (int e = 0; e < 3; ++e)
+        rim_edges.insert(FlatMap::pair(faces[f][e], faces[f][(e + 1) % 3]), 1);
+    result.tube_faces += static_cast<std::int32_t>(faces.size() - first_face);
     ++result.tubes;
-    commit(std::move(tube));
   }
+  change.added_faces.insert(change.added_faces.end(), faces.begin(), faces.end());
 }
 
 DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index,
@@ -690,15 +757,7 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
                        const std::vector<SegmentHit>& hits) {
   const Axis axis(tool);
   DrillResult result;
-  // The index inserts only the faces that survive all the drill's changes.
-  struct Batch {
-    FaceIndex* index;
-    const SkinnedMesh& mesh;
-    ~Batch() {
-      if (index) index->end_batch(mesh);
-    }
-  } batch{index, mesh};
-  if (index) index->begin_batch();
+  // The drill's one change: applied to the mesh, its adjacency and the index.
   auto commit = [&](TopologyChange&& ch) {
     apply(mesh, ch, &adjacency);
     if (index) index->update(mesh, ch);
@@ -912,20 +971,17 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
   for (const Face& t : added)
     for (auto v : t)
       if (region.verts[std::size_t(v)].index < 0) region.verts[std::size_t(v)].index = -2;
+  auto& new_x = region.new_x;  // their positions, for the tube
   for (auto& v : region.verts)
     if (v.index == -2) {
       v.index = ch.base_vertex_count + static_cast<std::int32_t>(ch.new_vertices.size());
       ch.new_vertices.push_back(v.def.new_vertex());
+      if (options.tube) new_x.push_back(v.x);
       result.rim_vertices += v.rim;
     }
   for (const auto& o : region.origins)
     if (o.modified) ch.removed_faces.push_back(o.face);
   std::sort(ch.removed_faces.begin(), ch.removed_faces.end());
-  ch.added_faces.reserve(added.size());
-  for (const Face& t : added)
-    ch.added_faces.push_back({region.verts[std::size_t(t[0])].index,
-                              region.verts[std::size_t(t[1])].index,
-                              region.verts[std::size_t(t[2])].index});
 
   // The rim loops, for the tube: per patch, the hole's boundary half-edges chained into one
   // loop of rim vertices (empty when they are not one simple loop).
@@ -946,19 +1002,41 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
       for (std::int32_t v = start; simple && count >= 3;) {
         const auto& x = region.verts[std::size_t(v)];
         if (!(x.rim || x.side == 0)) break;
-        loop.push_back(x.index);
+        loop.push_back(v);
         v = next.find(std::uint64_t(v));
         if (v < 0 || loop.size() > count) break;
         if (v == start) {
-          if (loop.size() == count) patches[p].rim = std::move(loop);
+          if (loop.size() == count) {
+            for (auto& l : loop) {
+              region.verts[std::size_t(l)].loop = true;
+              l = region.verts[std::size_t(l)].index;
+            }
+            patches[p].rim = std::move(loop);
+          }
           break;
         }
       }
     }
-
+  // The added faces, in mesh indices; with the tube, their half-edges between rim vertices
+  // (the only ones the tube's checks need).
+  ch.added_faces.reserve(added.size());
+  for (const Face& t : added) {
+    const auto &a = region.verts[std::size_t(t[0])], &b = region.verts[std::size_t(t[1])],
+               &c = region.verts[std::size_t(t[2])];
+    ch.added_faces.push_back({a.index, b.index, c.index});
+    if (options.tube) {
+      if (a.loop && b.loop) region.rim_edges.insert(FlatMap::pair(a.index, b.index), 1);
+      if (b.loop && c.loop) region.rim_edges.insert(FlatMap::pair(b.index, c.index), 1);
+      if (c.loop && a.loop) region.rim_edges.insert(FlatMap::pair(c.index, a.index), 1);
+    }
+  }
+  // 6. The tube walls join the rims in the same change.
+  if (options.tube) {
+    const Outcome out{mesh, adjacency, ch, new_x, region.rim_edges};
+    add_tubes(out, axis, patches, options.tube_ring_spacing, ch, new_x, region.rim_edges,
+              region.in_a, result);
+  }
   commit(std::move(ch));
-  if (options.tube)
-    join_holes(mesh, adjacency, axis, patches, options.tube_ring_spacing, result, commit);
   return result;
 }
 

@@ -22,19 +22,27 @@
 //   5. the inside is removed and the rim re-triangulated (split triangles stay triangles).
 // Vertices closer to the cylinder than snap_fraction of an edge are taken as rim vertices (not
 // moved), so there are no slivers; the computed rim points lie on the cylinder to rounding.
-// Refinement and hole are ONE TopologyChange: every new vertex is a combination of the corners
-// of the original face (or edge) it lies in (NewVertex::in_face / on_edge), so rest positions,
-// weights, UVs and normals follow in one step; refinement vertices come first, the rim's last.
+// Refinement, holes and tube walls are ONE TopologyChange, applied once: every new vertex of
+// the holes is a combination of the corners of the original face (or edge) it lies in
+// (NewVertex::in_face / on_edge), so rest positions, weights, UVs and normals follow in one
+// step; refinement vertices come first, then the rim's, then the tube's ring vertices (on
+// segments between two rim vertices: their parents may be new rim vertices of the same
+// change). The tube walls' faces come last in added_faces.
 //
 //   6. optionally (DrillOptions::tube), holes made in two walls of a closed surface, one where
 //      the drill enters and the next along the axis where it leaves, are joined by a tube wall:
 //      the two rim loops are stitched by a strip of triangles that walks both loops by angle
 //      around the axis (no new vertices: the tube's corners are the rim vertices), oriented as
 //      the surface, so that a closed input stays closed. A pair whose rims are not two simple
-//      loops winding once around the axis is left open (see message). With
+//      loops winding once around the axis, or share a vertex, or whose strip would reuse an
+//      edge of the changed mesh, is left open (see message); these checks are made on the
+//      change before it is applied (its added faces, and the mesh's adjacency for edges
+//      between original vertices whose faces the change keeps). With
 //      tube_ring_spacing > 0, intermediate rings of new vertices (each on the segment from a
 //      rim vertex to its partner, the other rim's vertex nearest in angle) split the wall so
-//      that its triangles are about as long as wide instead of spanning the whole wall.
+//      that its triangles are about as long as wide instead of spanning the whole wall:
+//      consecutive rings of one rim's spacing are joined quad by quad (shorter diagonal), and
+//      only the two loops where the spacing changes are merged by angle.
 // Each thread keeps the drill's scratch tables between calls (sized by its largest drill so far),
 // so that drilling at haptic rates allocates almost nothing.
 // Given a FaceIndex, the drill refits it first if it was marked moved and updates it for every
@@ -76,8 +84,9 @@ struct DrillOptions {
 };
 
 struct DrillResult {
-  std::vector<TopologyChange> changes;  // applied in order: the holes (with their refinement),
-                                        // then one per tube
+  // What the drill applied: one change (refinement, holes and tube walls), or none when it
+  // pierces nothing or removes nothing.
+  std::vector<TopologyChange> changes;
   std::int32_t holes = 0;
   std::int32_t rim_vertices = 0;          // new vertices on the cylinder
   std::int32_t snapped_rim_vertices = 0;  // existing vertices taken as rim vertices
