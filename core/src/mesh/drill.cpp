@@ -742,10 +742,13 @@ void add_tubes(const Outcome& out, const Axis& axis, const std::vector<Patch>& p
       fail("tube: the rims share vertices or edges");
       continue;
     }
-    // Later tubes see this one's edges.
+    // Later tubes see this one's edges between rim vertices (ring vertices are on no rim).
+    const std::int32_t rings_from = nv0 + std::int32_t(first_ring);
     for (std::size_t f = first_face; f < faces.size(); ++f)
-      for (int e = 0; e < 3; ++e)
-        rim_edges.insert(FlatMap::pair(faces[f][e], faces[f][(e + 1) % 3]), 1);
+      for (int e = 0; e < 3; ++e) {
+        const std::int32_t x = faces[f][e], y = faces[f][(e + 1) % 3];
+        if (x < rings_from && y < rings_from) rim_edges.insert(FlatMap::pair(x, y), 1);
+      }
     result.tube_faces += static_cast<std::int32_t>(faces.size() - first_face);
     ++result.tubes;
   }
