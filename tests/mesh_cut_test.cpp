@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <random>
+#include <set>
 
 #include <filesystem>
 #include "conform/cga/versor.hpp"
@@ -19,6 +21,70 @@ using namespace conform::mesh;
 using Plane = cga::Plane<double>;
 
 namespace {
+
+// The faces of `out` that are not faces of `in` (those an operation added), except `skip`,
+// each against the face of `in` it lies in (found geometrically: the input face containing
+// its centroid, on the current positions, which the operation did not move). Returns the
+// smallest angle (radians) of the added faces and the worst ratio of that angle to the
+// guarantee min(floor, half the smallest angle of the original face) (≥ 1: the guarantee holds).
+struct AngleReport {
+  double smallest = M_PI;      // smallest angle of an added face
+  double worst_ratio = 1e300;  // min over added faces of angle / guaranteed bound
+  int faces = 0;
+};
+AngleReport added_face_angles(const SkinnedMesh& in, const SkinnedMesh& out, double floor,
+                              const std::vector<Face>& skip = {}) {
+  auto key = [](Face f) {
+    std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
+    return f;
+  };
+  std::set<Face> old, skipped;
+  for (const Face& f : in.faces) old.insert(key(f));
+  for (const Face& f : skip) skipped.insert(key(f));
+  struct Orig {
+    Eigen::Vector3d a, b, c, centre;
+    double radius, angle;
+  };
+  std::vector<Orig> orig;
+  for (const Face& f : in.faces) {
+    Orig o{in.current.col(f[0]), in.current.col(f[1]), in.current.col(f[2]), {}, 0, 0};
+    o.centre = (o.a + o.b + o.c) / 3;
+    o.radius =
+        std::max({(o.a - o.centre).norm(), (o.b - o.centre).norm(), (o.c - o.centre).norm()});
+    o.angle = smallest_angle(o.a, o.b, o.c);
+    orig.push_back(o);
+  }
+  AngleReport r;
+  for (const Face& f : out.faces) {
+    if (old.count(key(f)) || skipped.count(key(f))) continue;
+    const Eigen::Vector3d a = out.current.col(f[0]), b = out.current.col(f[1]),
+                          c = out.current.col(f[2]), p = (a + b + c) / 3;
+    // The containing input face: smallest distance from p (barycentric clamp).
+    double best = 1e300, bound_angle = 0;
+    for (const Orig& o : orig) {
+      if ((p - o.centre).norm() > o.radius * (1 + 1e-9) + 1e-12) continue;
+      const Eigen::Vector3d n = (o.b - o.a).cross(o.c - o.a);
+      const double area2 = n.squaredNorm();
+      if (!(area2 > 0)) continue;
+      const double l0 = (o.c - o.b).cross(p - o.b).dot(n) / area2,
+                   l1 = (o.a - o.c).cross(p - o.c).dot(n) / area2, l2 = 1 - l0 - l1;
+      const double off = std::abs((p - o.a).dot(n)) / std::sqrt(area2) +
+                         std::max(0.0, -std::min({l0, l1, l2})) * o.radius;
+      if (off < best) best = off, bound_angle = o.angle;
+    }
+    ++r.faces;
+    const double angle = smallest_angle(a, b, c);
+    r.smallest = std::min(r.smallest, angle);
+    r.worst_ratio = std::min(r.worst_ratio, angle / std::min(floor, bound_angle / 2));
+  }
+  return r;
+}
+
+// The cap faces of a cut: the last 2 × cap_faces added faces when capping succeeded.
+std::vector<Face> cap_faces(const CutResult& r) {
+  const auto& added = r.change.added_faces;
+  return {added.end() - std::min<std::ptrdiff_t>(2 * r.cap_faces, std::ssize(added)), added.end()};
+}
 
 // Invariants every cut must keep (the input being closed/manifold/oriented where stated).
 // The input's report is cached by address: property tests cut the same input many times.
@@ -166,6 +232,8 @@ TEST(Cut, PropertyRandomPlanes) {
                                {"arm", make_arm(1).mesh, true}};
   std::mt19937 rng(1234);
   int cuts = 0, capped_all = 0;
+  std::map<std::string, double> smallest;  // of the faces the cuts added, caps excluded
+  for (const Model& model : models) smallest[model.name] = M_PI;
   for (const Model& model : models) {
     for (int trial = 0; trial < 400; ++trial) {
       SkinnedMesh m = model.mesh;
@@ -181,6 +249,12 @@ TEST(Cut, PropertyRandomPlanes) {
       }
       ++cuts;
       EXPECT_GE(out.pieces.count, 2) << what;
+      {
+        const AngleReport ar =
+            added_face_angles(model.mesh, m, kCutMinAngle, cap_faces(out.result));
+        smallest[model.name] = std::min(smallest[model.name], ar.smallest);
+        EXPECT_GE(ar.worst_ratio, 1 - 1e-9) << what << ": a sliver";
+      }
       expect_valid(m, model.mesh, what);
       expect_area_kept(model.mesh, m, out.result, what);
       if (cap && model.closed && out.result.capped_loops == out.result.loops) {
@@ -197,6 +271,8 @@ TEST(Cut, PropertyRandomPlanes) {
   }
   EXPECT_GT(cuts, 800);
   EXPECT_GT(capped_all, 250);
+  for (const auto& [name, a] : smallest)
+    RecordProperty("smallest_added_angle_deg_" + name, std::to_string(a * 180 / M_PI));
 }
 
 TEST(Cut, NewVerticesCarryAttributesAndWeights) {
@@ -346,6 +422,17 @@ TEST(Cut, SnappingAvoidsSlivers) {
   }
   EXPECT_GT(min_ratio, 0.01 * 0.01);
   expect_valid(s, s0, "snapped");
+  EXPECT_GE(added_face_angles(s0, s, kCutMinAngle).worst_ratio, 1 - 1e-9);
+  // A plane close to a grid line's vertices at a slant: crossings near them are snapped by
+  // the angle they would make, not only within 1 % of an edge.
+  SkinnedMesh t = s0;
+  Adjacency adj2(t);
+  const auto slant = cut(t, adj2, Plane::from_normal_distance({1, 0.02, 0}, 0.004));
+  ASSERT_EQ(slant.result.status, CutStatus::Cut);
+  EXPECT_GT(slant.result.snapped_vertices, 0);
+  expect_valid(t, s0, "slant");
+  EXPECT_GE(added_face_angles(s0, t, kCutMinAngle).worst_ratio, 1 - 1e-9);
+  expect_area_kept(s0, t, slant.result, "slant");
 }
 
 TEST(Cut, ReDeformation) {
@@ -416,6 +503,8 @@ TEST(Cut, PropertyRealModels) {
       const std::string what = std::string(file) + " trial " + std::to_string(trial);
       expect_valid(m, in, what);
       expect_area_kept(in, m, out.result, what);
+      EXPECT_GE(added_face_angles(in, m, kCutMinAngle, cap_faces(out.result)).worst_ratio, 1 - 1e-9)
+          << what << ": a sliver";
       if (testing::Test::HasFailure()) return;
     }
   }

@@ -62,6 +62,28 @@ double bounding_diagonal(const SkinnedMesh& mesh) {
                    (hi[2] - lo[2]) * (hi[2] - lo[2]));
 }
 
+double smallest_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                      const Eigen::Vector3d& c) {
+  auto at = [](const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& r) {
+    const Eigen::Vector3d u = q - p, v = r - p;
+    return std::atan2(u.cross(v).norm(), u.dot(v));
+  };
+  return std::min({at(a, b, c), at(b, c, a), at(c, a, b)});
+}
+
+double sliver_bound_sin2(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                         const Eigen::Vector3d& c, double floor) {
+  const double s = std::sin(floor);
+  // sin²(α/2) = (1 − cos α) / 2 for the smallest angle α, the one between the longer sides.
+  const double ab = (b - a).squaredNorm(), bc = (c - b).squaredNorm(), ca = (a - c).squaredNorm();
+  double l1 = ab, l2 = bc, shortest = ca;  // the two longer sides and the shortest
+  if (ab < shortest) std::swap(l1, shortest);
+  if (bc < shortest) std::swap(l2, shortest);
+  if (!(l1 > 0 && l2 > 0)) return 0;
+  const double cosine = std::clamp((l1 + l2 - shortest) / (2 * std::sqrt(l1 * l2)), -1.0, 1.0);
+  return std::min(s * s, (1 - cosine) / 2);
+}
+
 std::string MeshReport::summary() const {
   return std::string(indices_valid ? "" : "invalid indices; ") +
          (finite ? "" : "non-finite positions; ") + "tiny faces " + std::to_string(tiny_faces) +

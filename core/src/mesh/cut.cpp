@@ -29,6 +29,19 @@ struct Pending {
   bool remapped = false;
 };
 
+// The quad (a, b, c, d) split along the diagonal (a, c) or (b, d), whichever gives the larger
+// smallest angle (the first on a tie), and that angle's sin².
+struct QuadSplit {
+  bool first_diagonal;
+  double quality;
+};
+QuadSplit best_quad_split(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                          const Eigen::Vector3d& c, const Eigen::Vector3d& d) {
+  const double q1 = std::min(smallest_angle_sin2(a, b, c), smallest_angle_sin2(a, c, d));
+  const double q2 = std::min(smallest_angle_sin2(a, b, d), smallest_angle_sin2(b, c, d));
+  return q1 >= q2 ? QuadSplit{true, q1} : QuadSplit{false, q2};
+}
+
 std::int32_t root(std::vector<std::int32_t>& p, std::int32_t x) {
   while (p[static_cast<std::size_t>(x)] != x)
     x = p[static_cast<std::size_t>(x)] =
@@ -60,8 +73,9 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
                       const CutOptions& options) {
   const cga::Plane<double> plane = unit_plane(plane_in);
   if (!(options.snap_fraction >= 0 && options.snap_fraction < 0.5) ||
-      !(options.plane_tolerance >= 0))
-    throw std::invalid_argument("cut: snap_fraction must be in [0, 0.5) and plane_tolerance ≥ 0");
+      !(options.plane_tolerance >= 0) || !(options.min_angle >= 0 && options.min_angle < 0.5))
+    throw std::invalid_argument(
+        "cut: snap_fraction must be in [0, 0.5), plane_tolerance ≥ 0 and min_angle in [0, 0.5)");
   const std::int32_t nv0 = mesh.vertex_count();
   const std::int32_t nf0 = mesh.face_count();
   if (mesh.current.cols() != nv0)
@@ -160,22 +174,129 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     face_pos = (any & 2) != 0, face_neg = (any & 8) != 0;
   }
 
-  // Snap crossings that fall too close to an end of their edge onto that end (only faces in
-  // `work` have crossed edges, and every face around a vertex that may be snapped is there).
+  // Step 2, snapping, face by face: a crossed face whose split (by the vertices' current sides)
+  // would make a triangle with smallest angle below its bound — min(min_angle, half the
+  // face's smallest angle) — or whose crossing lies within snap_fraction of an edge's end, has
+  // one vertex taken as on the plane: of the vertices whose snapping makes this face acceptable
+  // (the lone vertex always does), the nearest to the plane. Snapping only uncrosses faces, so
+  // the faces a snap touched are evaluated again until none snaps. Vertices never move.
+  const double* const px = mesh.current.data();
+  auto point = [px](std::int32_t v) { return Eigen::Vector3d::Map(px + 3 * std::size_t(v)); };
+  auto crossing_point = [&](std::int32_t u, std::int32_t w) -> Eigen::Vector3d {
+    const std::int32_t a = std::min(u, w), b = std::max(u, w);
+    const double da = dist[static_cast<std::size_t>(a)], db = dist[static_cast<std::size_t>(b)];
+    const double t = da / (da - db);
+    return (1 - t) * point(a) + t * point(b);
+  };
+  auto crossing_t = [&](std::int32_t from, std::int32_t to) {  // from `from` along the edge
+    const double df = dist[static_cast<std::size_t>(from)], dt = dist[static_cast<std::size_t>(to)];
+    return df / (df - dt);
+  };
+  // The split of face f with sides s (crossed): the quality (smallest angle's sin²) of its
+  // worst triangle, and whether a crossing falls within `snap` of an edge's end.
+  auto split_quality = [&](const Face& f, const std::int8_t* s) {
+    int zero = -1;
+    for (int k = 0; k < 3; ++k)
+      if (s[k] == 0) zero = k;
+    if (zero >= 0) {
+      const std::int32_t v0 = f[zero], v1 = f[(zero + 1) % 3], v2 = f[(zero + 2) % 3];
+      const double t = crossing_t(v1, v2);
+      if (t < snap || t > 1 - snap) return -1.0;
+      const Eigen::Vector3d x = crossing_point(v1, v2);
+      return std::min(smallest_angle_sin2(point(v0), point(v1), x),
+                      smallest_angle_sin2(point(v0), x, point(v2)));
+    }
+    int lone = 0;
+    for (int k = 0; k < 3; ++k)
+      if (s[(k + 1) % 3] == s[(k + 2) % 3]) lone = k;
+    const std::int32_t v0 = f[lone], v1 = f[(lone + 1) % 3], v2 = f[(lone + 2) % 3];
+    const double t01 = crossing_t(v0, v1), t02 = crossing_t(v0, v2);
+    if (t01 < snap || t01 > 1 - snap || t02 < snap || t02 > 1 - snap) return -1.0;
+    const Eigen::Vector3d x01 = crossing_point(v0, v1), x20 = crossing_point(v2, v0);
+    const Eigen::Vector3d p0 = point(v0), p1 = point(v1), p2 = point(v2);
+    return std::min(smallest_angle_sin2(p0, x01, x20), best_quad_split(x01, p1, p2, x20).quality);
+  };
+  const double floor_sin2 = std::sin(options.min_angle) * std::sin(options.min_angle);
+  std::vector<std::int32_t> crossed, evaluate, again;
+  std::vector<std::int32_t> snapped_now;
+  bool outside_work = false;  // a vertex not flagged near was snapped: its faces are not in work
   for (const std::int32_t fi : work) {
     const Face& f = faces[fi];
-    for (int k = 0; k < 3; ++k) {
-      const std::int32_t a = std::min(f[k], f[(k + 1) % 3]), b = std::max(f[k], f[(k + 1) % 3]);
-      std::int8_t& sa = sd[a];
-      std::int8_t& sb = sd[b];
-      if (sa * sb >= 0) continue;
-      const double da = dist[static_cast<std::size_t>(a)], db = dist[static_cast<std::size_t>(b)];
-      const double t = da / (da - db);
-      if (t < snap)
-        sa = 0, ++result.snapped_vertices;
-      else if (t > 1 - snap)
-        sb = 0, ++result.snapped_vertices;
+    if (sd[f[0]] * sd[f[1]] < 0 || sd[f[1]] * sd[f[2]] < 0 || sd[f[2]] * sd[f[0]] < 0)
+      crossed.push_back(fi);
+  }
+  evaluate = crossed;
+  while (!evaluate.empty()) {
+    snapped_now.clear();
+    for (const std::int32_t fi : evaluate) {
+      const Face& f = faces[fi];
+      std::int8_t s[3] = {sd[f[0]], sd[f[1]], sd[f[2]]};
+      if (!(s[0] * s[1] < 0 || s[1] * s[2] < 0 || s[2] * s[0] < 0)) continue;
+      const double quality = split_quality(f, s);
+      if (quality >= floor_sin2) continue;  // the bound is never above the floor
+      const double bound =
+          sliver_bound_sin2(point(f[0]), point(f[1]), point(f[2]), options.min_angle);
+      if (quality >= bound) continue;
+      // The fewest vertices, nearest the plane, that make this face acceptable: taking two of
+      // its vertices as on the plane always does (it is no longer crossed), so the nearest alone
+      // if that suffices, else the second nearest alone if that does, else both.
+      int order[3] = {0, 1, 2};
+      std::sort(order, order + 3, [&](int i, int j) {
+        const double di = s[i] == 0 ? -1 : std::abs(dist[static_cast<std::size_t>(f[i])]);
+        const double dj = s[j] == 0 ? -1 : std::abs(dist[static_cast<std::size_t>(f[j])]);
+        return di < dj || (di == dj && i < j);
+      });
+      const int first = s[order[0]] == 0 ? 1 : 0;  // skip a vertex already on the plane
+      auto acceptable_without = [&](int k) {
+        const std::int8_t keep = s[k];
+        s[k] = 0;
+        const bool ok = !(s[0] * s[1] < 0 || s[1] * s[2] < 0 || s[2] * s[0] < 0) ||
+                        split_quality(f, s) >= bound;
+        s[k] = keep;
+        return ok;
+      };
+      auto snap_vertex = [&](std::int32_t v) {
+        sd[v] = 0;
+        ++result.snapped_vertices;
+        snapped_now.push_back(v);
+        if (!(cd[v] & 16)) outside_work = true;
+      };
+      if (acceptable_without(order[first])) {
+        snap_vertex(f[order[first]]);
+      } else if (first == 0 && acceptable_without(order[1])) {
+        snap_vertex(f[order[1]]);
+      } else {
+        snap_vertex(f[order[first]]);
+        if (first == 0) snap_vertex(f[order[1]]);
+      }
     }
+    // Faces touched by this round's snaps that are still crossed: evaluate them again.
+    std::sort(snapped_now.begin(), snapped_now.end());
+    again.clear();
+    if (!snapped_now.empty())
+      for (const std::int32_t fi : crossed) {
+        const Face& f = faces[fi];
+        bool touched = false;
+        for (auto v : f) touched |= std::binary_search(snapped_now.begin(), snapped_now.end(), v);
+        if (touched &&
+            (sd[f[0]] * sd[f[1]] < 0 || sd[f[1]] * sd[f[2]] < 0 || sd[f[2]] * sd[f[0]] < 0))
+          again.push_back(fi);
+      }
+    evaluate.swap(again);
+  }
+  if (outside_work) {
+    // Rare (a crossing far along its edge, in a poorly shaped face): the faces around a snapped
+    // vertex that step 1 did not flag, found by one more pass over the faces.
+    const auto before = work.size();
+    for (std::size_t fi = 0; fi < nf; ++fi) {
+      const Face& f = faces[fi];
+      const int fc = cd[f[0]] | cd[f[1]] | cd[f[2]];
+      if (!(fc == 2 || fc == 8)) continue;  // already in work
+      if (sd[f[0]] == 0 || sd[f[1]] == 0 || sd[f[2]] == 0)
+        work.push_back(static_cast<std::int32_t>(fi));
+    }
+    std::inplace_merge(work.begin(), work.begin() + static_cast<std::ptrdiff_t>(before),
+                       work.end());
   }
 
   TopologyChange& ch = result.change;
@@ -253,7 +374,7 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     const std::int8_t s0 = s[lone];
     const auto s1 = static_cast<std::int8_t>(-s0);
     pending.push_back({{v0, x01, x20}, {v0, x01, x20}, s0, -1});
-    if ((pos(x01) - pos(v2)).squaredNorm() <= (pos(v1) - pos(x20)).squaredNorm()) {
+    if (best_quad_split(pos(x01), pos(v1), pos(v2), pos(x20)).first_diagonal) {
       pending.push_back({{x01, v1, v2}, {x01, v1, v2}, s1, -1});
       pending.push_back({{x01, v2, x20}, {x01, v2, x20}, s1, -1});
     } else {

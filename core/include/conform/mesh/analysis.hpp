@@ -2,6 +2,7 @@
 // invariants the topology operations must keep, and the split into connected pieces.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -20,6 +21,28 @@ double surface_area(const SkinnedMesh& mesh, std::span<const std::int32_t> faces
 double signed_volume(const SkinnedMesh& mesh, std::span<const std::int32_t> faces = {});
 /// Length of the diagonal of the current positions' bounding box (0 for an empty mesh).
 double bounding_diagonal(const SkinnedMesh& mesh);
+
+/// Triangle quality without trigonometry: the squared sine of the smallest angle of (a, b, c)
+/// (the angle opposite the shortest side, which is acute), 0 for a degenerate triangle. It
+/// orders triangles as their smallest angles do.
+inline double smallest_angle_sin2(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                  const Eigen::Vector3d& c) {
+  const double ab = (b - a).squaredNorm(), bc = (c - b).squaredNorm(), ca = (a - c).squaredNorm();
+  const double cross2 = (b - a).cross(c - a).squaredNorm();  // (2 × area)²
+  // sin² of the angle between the two longer sides: cross² / (their squared lengths' product).
+  const double longer = std::max({ab * bc, bc * ca, ca * ab});
+  return longer > 0 ? cross2 / longer : 0.0;
+}
+
+/// The smallest angle of (a, b, c) in radians (0 for a degenerate triangle).
+double smallest_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c);
+
+/// The sliver guarantee of the topology operations (cut, tear, drill): every face an operation
+/// adds inside an original face has smallest angle ≥ min(floor, half the smallest angle of that
+/// original face). This returns that bound as a squared sine (compare with
+/// smallest_angle_sin2), for the original face (a, b, c) and `floor` in radians.
+double sliver_bound_sin2(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                         const Eigen::Vector3d& c, double floor);
 
 struct MeshReport {
   bool indices_valid = true;              // every face index in [0, #V), no repeated vertex

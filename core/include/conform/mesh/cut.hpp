@@ -2,11 +2,17 @@
 //
 //   1. classify every vertex once by X·Π (conformal point against the plane Π = n + d e∞);
 //      vertices within plane_tolerance × (bounding diagonal) are on the plane;
-//   2. snap: where Π crosses an edge closer than snap_fraction of its length to an end, that
-//      end is taken as on the plane instead (no needle triangles); vertices are never moved;
+//   2. snap (no slivers): every crossed face is split in thought; if a triangle of its split
+//      would have its smallest angle below min(min_angle, half the smallest angle of the face)
+//      — or a crossing lies within snap_fraction of an edge's end — the fewest of its vertices,
+//      nearest the plane, are taken as on the plane instead (the nearest alone if that makes
+//      the split acceptable, else the second nearest, else both, which uncrosses the face),
+//      until no face needs it. Vertices are never moved: a snapped vertex stays where it is, at
+//      most about its face's size off the plane (in the property tests: ≤ 0.4 of the mean edge
+//      on the arm, ≤ 1.1 at the cylinder's thin cap fans);
 //   3. one new vertex per crossed edge (edge parameter t from the lower vertex index), shared
-//      by the faces on both sides; split triangles stay triangles (a quad is split along its
-//      shorter diagonal);
+//      by the faces on both sides; split triangles stay triangles (a quad is split along the
+//      diagonal that gives the larger smallest angle);
 //   4. separate the sides: the positive side keeps the original vertices, every fan of faces
 //      around a loop vertex beyond the first gets a duplicate (normally: the negative side);
 //      faces lying in the plane go to the side opposite their normal;
@@ -15,6 +21,16 @@
 //      built with CGAL, else ear clipping with holes bridged), filled by nesting parity, so
 //      loops inside loops (a hollow tube, a torus cut through its hole) give rings.
 // Pieces are then the connected components (label_pieces), so one plane may give many.
+//
+// Sliver guarantee: every face the cut adds inside an original face (caps excluded: their
+// constrained Delaunay triangulation is bounded by the cut loop's own geometry) has smallest
+// angle ≥ min(min_angle, half the smallest angle of that original face). The default floor,
+// kCutMinAngle = 5°, was chosen by measurement over the property tests (1,550 random planes on
+// the arm, a sphere, a cylinder and a sheet): floors of 1°, 2°, 5° and 10° snap about 2.5, 5, 12
+// and 23 vertices per cut of the arm and move the cut off the plane by at most 0.18, 0.29, 0.37
+// and 0.37 mean edges on the arm (0.28, 0.51, 1.05, 1.13 on the cylinder, whose cap fans have
+// 11° corners); 5° keeps the deviation under half an edge on well-shaped meshes. Without the
+// angle rule (1 % snapping alone) the smallest added angle was 0.10°.
 //
 // Degenerate input: a non-finite or zero-normal plane, or non-finite positions, throw
 // std::invalid_argument; a plane that misses or only touches the mesh returns status Missed
@@ -36,9 +52,13 @@ namespace conform::mesh {
 /// X·Π with X = up(x), or the plain Euclidean n·x − d (kept for the paper's Table 1).
 enum class Predicates { Cga, Euclidean };
 
+/// The cut's sliver floor θ_floor (radians): see CutOptions::min_angle.
+inline constexpr double kCutMinAngle = 5.0 * 3.14159265358979323846 / 180;
+
 struct CutOptions {
-  double plane_tolerance = 1e-9;  // × bounding diagonal
-  double snap_fraction = 0.01;    // of an edge's length
+  double plane_tolerance = 1e-9;    // × bounding diagonal
+  double snap_fraction = 0.01;      // of an edge's length
+  double min_angle = kCutMinAngle;  // sliver floor θ_floor, radians, in [0, 0.5); 0: off
   bool cap = false;
   Predicates predicates = Predicates::Cga;
   SectionTriangulator cap_triangulator = SectionTriangulator::Best;
@@ -51,7 +71,7 @@ struct CutResult {
   TopologyChange change;
   std::vector<std::int8_t> added_side;  // +1 / −1 for each added face (caps included)
   std::int32_t crossed_edges = 0;
-  std::int32_t snapped_vertices = 0;  // vertices taken as on the plane by step 2
+  std::int32_t snapped_vertices = 0;  // vertices taken as on the plane by step 2 (snaps)
   std::int32_t loops = 0;             // closed cut loops found (when capping)
   std::int32_t capped_loops = 0;
   std::int32_t nested_loops = 0;  // capped loops inside another loop (holes, islands)
