@@ -13,8 +13,11 @@
 
 #include "conform/io/import.hpp"
 #include "conform/mesh/analysis.hpp"
+#include "conform/mesh/cut.hpp"
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/tear.hpp"
+#include "conform/skin/pose.hpp"
+#include "skin_reference.hpp"
 
 using namespace conform;
 using namespace conform::mesh;
@@ -27,6 +30,7 @@ const char* const kModels[] = {"FBX/huesitos.fbx", "X/anim_test.x",
 struct RealModel {
   std::string file;
   SkinnedMesh mesh;
+  std::vector<skin::Versor> poses[2];  // skinning versors at 30 % and 80 % of its first animation
 };
 // The installed ones, loaded once.
 const std::vector<RealModel>& real_models() {
@@ -34,7 +38,20 @@ const std::vector<RealModel>& real_models() {
     std::vector<RealModel> out;
     for (const char* file : kModels) {
       const std::filesystem::path path = std::filesystem::path(CONFORM_ASSIMP_MODELS) / file;
-      if (std::filesystem::exists(path)) out.push_back({file, io::load_model(path.string()).mesh});
+      if (!std::filesystem::exists(path)) continue;
+      const io::SkinnedModel model = io::load_model(path.string());
+      RealModel real{file, model.mesh, {}};
+      for (int k = 0; k < 2 && !model.animations.empty(); ++k) {
+        skin::Pose pose;
+        const auto& animation = model.animations.front();
+        animation.sample(model.skeleton, (k == 0 ? 0.3 : 0.8) * animation.duration(),
+                         skin::Blend::linear, pose);
+        std::vector<skin::Versor> global(std::size_t(model.skeleton.joint_count()));
+        real.poses[k].resize(std::size_t(model.skeleton.bone_count()));
+        skin::global_versors(model.skeleton, pose, global);
+        skin::skinning_versors(model.skeleton, global, real.poses[k]);
+      }
+      out.push_back(std::move(real));
     }
     return out;
   }();
@@ -87,7 +104,7 @@ TEST(RealModels, TearStrokesAcrossRandomFaces) {
   // boundary edges at its seams, simple_skin.gltf an 8-face strip), so a stroke stops where
   // its walk meets a boundary (documented: the sample is a no-op) or the blade leaves the model.
   int strokes = 0, grew = 0;
-  for (const auto& [file, in] : real_models()) {
+  for (const auto& [file, in, poses] : real_models()) {
     // Short steps, a blade a tenth of the model long: real models have few, long faces.
     const double edge = mean_edge(in), reach = 0.05 * bounding_diagonal(in),
                  step = std::min(0.25 * edge, 0.01 * bounding_diagonal(in));
@@ -136,7 +153,7 @@ TEST(RealModels, DrillsThroughRandomFaces) {
   // the rim's new vertices lie on the cylinder, the area removed is what the drill reports,
   // and nothing gets worse.
   int drills = 0;
-  for (const auto& [file, in] : real_models()) {
+  for (const auto& [file, in, poses] : real_models()) {
     const double edge = mean_edge(in);
     std::mt19937 rng(23);
     std::uniform_int_distribution<std::int32_t> face(0, in.face_count() - 1);
@@ -167,4 +184,90 @@ TEST(RealModels, DrillsThroughRandomFaces) {
   if (drills == 0) GTEST_SKIP() << "assimp-testmodels not installed";
   EXPECT_EQ(drills, 240) << "every drill through a face makes a hole";
   RecordProperty("drills", drills);
+}
+
+TEST(RealModels, ReDeformation) {
+  // Each model posed by its own animation (at 30 % of it), then cut (capped), drilled and torn
+  // on the posed surface, then re-skinned with the animation at 80 %: against the original
+  // re-skinned at 80 % with the same changes applied, vertex by vertex. Original vertices and
+  // new ones whose parents share their influences agree to 1e-9 of the model's size; a new
+  // vertex between parents of different influences moves by the t(1 − t) term of LBS (not
+  // linear in the weights), bounded by the longest edge it was made on.
+  int models = 0;
+  for (const auto& [file, original, poses] : real_models()) {
+    if (poses[0].empty()) continue;
+    ++models;
+    const double size = bounding_diagonal(original);
+    SkinnedMesh posed = original;
+    posed.current = conform::test::reference_lbs(original, poses[0]);
+    SkinnedMesh a = posed;
+    Adjacency adjacency(a);
+    std::vector<TopologyChange> changes;
+    // A plane through the middle, across the model's longest extent.
+    const Eigen::Vector3d lo = posed.current.rowwise().minCoeff(),
+                          hi = posed.current.rowwise().maxCoeff();
+    Eigen::Index axis = 0;
+    (hi - lo).maxCoeff(&axis);
+    const Eigen::Vector3d normal = Eigen::Vector3d::Unit(axis) + Eigen::Vector3d(0.1, 0.2, 0.3);
+    const auto cut_out =
+        cut(a, adjacency, cga::Plane<double>::from_normal_point(normal, 0.5 * (lo + hi)),
+            {.cap = true});
+    if (cut_out.result.status == CutStatus::Cut) changes.push_back(cut_out.result.change);
+    // A drill through the face nearest a third of the way along, and a short stroke.
+    const std::int32_t f = a.face_count() / 3;
+    const Eigen::Vector3d n = unit_normal(a, f),
+                          c = (corner(a, f, 0) + corner(a, f, 1) + corner(a, f, 2)) / 3;
+    const double edge = mean_edge(a);
+    for (auto& ch : drill(a, adjacency, {c - edge * n, c + edge * n, 0.4 * edge}).changes)
+      changes.push_back(std::move(ch));
+    const std::int32_t g = 2 * a.face_count() / 3;
+    const Eigen::Vector3d m = unit_normal(a, g),
+                          d = (corner(a, g, 0) + corner(a, g, 1) + corner(a, g, 2)) / 3;
+    const Eigen::Vector3d heading = m.unitOrthogonal();
+    Tear tear(a, adjacency);
+    for (int i = 0; i < 8; ++i) {
+      const Eigen::Vector3d p = d + 0.1 * edge * i * heading;
+      for (auto& ch : tear.advance({double(i), p + 0.05 * size * m, p - 0.05 * size * m}).changes)
+        changes.push_back(std::move(ch));
+    }
+    ASSERT_GE(changes.size(), 3u) << file;
+
+    a.current = conform::test::reference_lbs(a, poses[1]);
+    SkinnedMesh b = original;
+    b.current = conform::test::reference_lbs(original, poses[1]);
+    double longest = 0;
+    for (std::int32_t face = 0; face < original.face_count(); ++face)
+      for (int k = 0; k < 3; ++k)
+        longest = std::max(
+            longest, (b.current.col(original.faces[std::size_t(face)][std::size_t(k)]) -
+                      b.current.col(original.faces[std::size_t(face)][std::size_t((k + 1) % 3)]))
+                         .norm());
+    std::vector<char> exact(std::size_t(original.vertex_count()), 1);
+    for (const TopologyChange& ch : changes) {
+      for (const NewVertex& v : ch.new_vertices) {
+        bool same = exact[std::size_t(v.parents[0])] != 0;
+        for (int k = 1; k < 3; ++k)
+          if (v.parents[k] >= 0)
+            same = same && exact[std::size_t(v.parents[k])] &&
+                   b.bones.col(v.parents[k]) == b.bones.col(v.parents[0]) &&
+                   b.weights.col(v.parents[k]) == b.weights.col(v.parents[0]);
+        exact.push_back(same);
+      }
+      apply(b, ch);
+    }
+    ASSERT_EQ(a.vertex_count(), b.vertex_count()) << file;
+    EXPECT_EQ(a.faces, b.faces) << file;
+    double worst_exact = 0, worst_blend = 0;
+    for (Eigen::Index v = 0; v < a.current.cols(); ++v) {
+      const double err = (a.current.col(v) - b.current.col(v)).norm();
+      (exact[std::size_t(v)] ? worst_exact : worst_blend) =
+          std::max(exact[std::size_t(v)] ? worst_exact : worst_blend, err);
+    }
+    EXPECT_LT(worst_exact, 1e-9 * size) << file;
+    EXPECT_LT(worst_blend, longest) << file;
+    RecordProperty(file + " worst_exact_over_size", std::to_string(worst_exact / size));
+    RecordProperty(file + " worst_blended_over_longest_edge",
+                   std::to_string(worst_blend / longest));
+  }
+  if (models == 0) GTEST_SKIP() << "no animated model of assimp-testmodels installed";
 }
