@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 #include <random>
 
@@ -27,6 +28,66 @@ void expect_valid(const SkinnedMesh& m, const std::string& what) {
   for (Eigen::Index v = 0; v < m.weights.cols() && bad < 0; ++v)
     if (std::abs(m.weights.col(v).sum() - 1.0) > 1e-12) bad = v;
   EXPECT_EQ(bad, -1) << what;
+}
+
+// The smallest angle (radians) of triangle (a, b, c).
+double triangle_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                      const Eigen::Vector3d& c) {
+  const Eigen::Vector3d p[3] = {a, b, c};
+  double smallest = std::numbers::pi;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d u = p[(k + 1) % 3] - p[k], w = p[(k + 2) % 3] - p[k];
+    smallest = std::min(smallest, std::atan2(u.cross(w).norm(), u.dot(w)));
+  }
+  return smallest;
+}
+
+// The drill's angle guarantee (drill.hpp): every face its change adds, except the tube walls'
+// (the last `tube_faces`), has its smallest angle at least min(floor, half the smallest angle
+// of the original face it lies in). `before` is the mesh the change was computed for, `after`
+// the changed one. Returns the worst ratio angle / bound (≥ 1 when the guarantee holds;
+// +∞ when no face was checked) and lowers `smallest` to the smallest angle checked.
+struct AngleCheck {
+  double worst_ratio = std::numeric_limits<double>::infinity();
+  double smallest = std::numbers::pi;
+  int faces = 0;
+};
+void check_angles(const SkinnedMesh& before, const SkinnedMesh& after, const TopologyChange& ch,
+                  std::int32_t tube_faces, AngleCheck& out) {
+  const double floor = DrillOptions{}.min_angle_degrees * std::numbers::pi / 180;
+  std::map<std::array<std::int32_t, 3>, std::int32_t> original;  // sorted corners → face
+  for (auto f : ch.removed_faces) {
+    std::array<std::int32_t, 3> t = before.faces[static_cast<std::size_t>(f)];
+    std::sort(t.begin(), t.end());
+    original[t] = f;
+  }
+  const std::int32_t nv0 = ch.base_vertex_count;
+  for (std::size_t i = 0; i + std::size_t(tube_faces) < ch.added_faces.size(); ++i) {
+    const Face& t = ch.added_faces[i];
+    std::vector<std::int32_t> corners;
+    for (auto v : t) {
+      if (v < nv0) {
+        corners.push_back(v);
+        continue;
+      }
+      for (auto p : ch.new_vertices[static_cast<std::size_t>(v - nv0)].parents)
+        if (p >= 0) corners.push_back(p);
+    }
+    std::sort(corners.begin(), corners.end());
+    corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+    ASSERT_EQ(corners.size(), 3u) << "added face " << i << " lies in no original face";
+    const auto it = original.find({corners[0], corners[1], corners[2]});
+    ASSERT_NE(it, original.end()) << "added face " << i << " lies in no removed face";
+    const Face& o = before.faces[static_cast<std::size_t>(it->second)];
+    const double bound =
+        std::min(floor, 0.5 * triangle_angle(before.current.col(o[0]), before.current.col(o[1]),
+                                             before.current.col(o[2])));
+    const double angle =
+        triangle_angle(after.current.col(t[0]), after.current.col(t[1]), after.current.col(t[2]));
+    out.worst_ratio = std::min(out.worst_ratio, angle / bound);
+    out.smallest = std::min(out.smallest, angle);
+    ++out.faces;
+  }
 }
 
 }  // namespace
@@ -112,6 +173,7 @@ TEST(Drill, PropertyRandomDrillsOnTheArm) {
   std::mt19937 rng(77);
   std::uniform_real_distribution<double> u(0, 1);
   int holes = 0;
+  AngleCheck angles;
   for (int trial = 0; trial < 400; ++trial) {
     SkinnedMesh m = arm;
     Adjacency adj(m);
@@ -125,18 +187,26 @@ TEST(Drill, PropertyRandomDrillsOnTheArm) {
     holes += d.holes;
     expect_valid(m, "arm trial " + std::to_string(trial));
     EXPECT_EQ(label_pieces(m).count, 1) << trial;
+    for (const TopologyChange& ch : d.changes) check_angles(arm, m, ch, 0, angles);
     if (testing::Test::HasFailure()) break;
   }
   EXPECT_GT(holes, 500);
+  EXPECT_GE(angles.worst_ratio, 1.0)
+      << "smallest angle " << angles.smallest * 180 / std::numbers::pi << " degrees";
+  RecordProperty("smallest_added_angle_degrees",
+                 std::to_string(angles.smallest * 180 / std::numbers::pi));
+  RecordProperty("worst_angle_over_bound", std::to_string(angles.worst_ratio));
 }
 
 TEST(Drill, PropertyRandomDrillsOnSheetAndSphere) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1, 1);
   int holes = 0;
+  AngleCheck angles;
   for (int trial = 0; trial < 400; ++trial) {
     const bool sheet = trial % 2 == 0;
-    SkinnedMesh m = sheet ? make_sheet(24, 24) : make_icosphere(3);
+    const SkinnedMesh before = sheet ? make_sheet(24, 24) : make_icosphere(3);
+    SkinnedMesh m = before;
     const double a0 = surface_area(m);
     Adjacency adj(m);
     const Eigen::Vector3d c(0.3 * u(rng), 0.3 * u(rng), sheet ? 0.0 : 0.3 * u(rng));
@@ -147,9 +217,14 @@ TEST(Drill, PropertyRandomDrillsOnSheetAndSphere) {
     holes += d.holes;
     expect_valid(m, (sheet ? "sheet " : "sphere ") + std::to_string(trial));
     EXPECT_NEAR(a0 - surface_area(m), d.removed_area, 1e-12 * a0) << trial;
+    for (const TopologyChange& ch : d.changes) check_angles(before, m, ch, 0, angles);
     if (testing::Test::HasFailure()) break;
   }
   EXPECT_GT(holes, 500);
+  EXPECT_GE(angles.worst_ratio, 1.0)
+      << "smallest angle " << angles.smallest * 180 / std::numbers::pi << " degrees";
+  RecordProperty("smallest_added_angle_degrees",
+                 std::to_string(angles.smallest * 180 / std::numbers::pi));
 }
 
 namespace {
@@ -298,6 +373,7 @@ TEST(Drill, PropertyRandomTubesThroughTheArm) {
   std::mt19937 rng(78);
   std::uniform_real_distribution<double> u(0, 1);
   int tubes = 0;
+  AngleCheck angles;
   FaceIndex index;
   for (int trial = 0; trial < 150; ++trial) {
     SkinnedMesh m = arm;
@@ -312,6 +388,8 @@ TEST(Drill, PropertyRandomTubesThroughTheArm) {
     o.tube_ring_spacing = trial % 2 ? 2.0 : 0.0;  // half of them with rings
     const DrillResult d = drill(m, adj, index, {c - 0.2 * dir, c + 0.2 * dir, r}, o);
     tubes += d.tubes;
+    // The angle guarantee holds for the holes' faces (the tube walls are exempt: drill.hpp).
+    for (const TopologyChange& ch : d.changes) check_angles(arm, m, ch, d.tube_faces, angles);
     const MeshReport rep = check_mesh(m, 1e-14 * std::pow(bounding_diagonal(m), 2));
     EXPECT_TRUE(rep.manifold() && rep.oriented()) << trial << ": " << rep.summary();
     EXPECT_EQ(rep.tiny_faces, 0) << trial;
@@ -322,6 +400,8 @@ TEST(Drill, PropertyRandomTubesThroughTheArm) {
     if (testing::Test::HasFailure()) break;
   }
   EXPECT_GT(tubes, 135) << "most drills through the arm get their tube";
+  EXPECT_GE(angles.worst_ratio, 1.0)
+      << "smallest angle " << angles.smallest * 180 / std::numbers::pi << " degrees";
 }
 
 namespace {
@@ -353,13 +433,15 @@ TEST(Drill, OneLocalChangeOfOriginalVertices) {
   // Random drills through the arm (no tube): refinement and hole are one change; every new
   // vertex is a combination of 2 or 3 ORIGINAL vertices (no nesting), used by a face (nothing
   // orphaned inside the hole), the rim's last and on the cylinder; and only faces near the rim
-  // change: every removed face comes within r + 2 × the longest edge of the axis.
+  // change: every removed face comes within r + 2 × the longest edge of the axis; and the
+  // angle guarantee holds (the smallest angle of the whole drilled arm is recorded too).
   const SkinnedMesh arm = make_arm(1).mesh;
   const double edge = longest_edge(arm);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0, 1);
   int holes = 0;
   double farthest = 0, sharpest = std::numbers::pi;
+  AngleCheck angles;
   for (int trial = 0; trial < 200; ++trial) {
     SkinnedMesh m = arm;
     Adjacency adj(m);
@@ -403,9 +485,12 @@ TEST(Drill, OneLocalChangeOfOriginalVertices) {
       EXPECT_LE(nearest, tool.radius + 2 * edge) << what << ": face " << f << " changed";
     }
     sharpest = std::min(sharpest, smallest_angle(m, 0));
+    check_angles(arm, m, ch, 0, angles);
     if (testing::Test::HasFailure()) break;
   }
   EXPECT_GT(holes, 250);
+  EXPECT_GE(angles.worst_ratio, 1.0)
+      << "smallest angle " << angles.smallest * 180 / std::numbers::pi << " degrees";
   RecordProperty("farthest_changed_face_in_edges", std::to_string(farthest));
   RecordProperty("smallest_angle_degrees", std::to_string(sharpest * 180 / std::numbers::pi));
 }
@@ -413,15 +498,17 @@ TEST(Drill, OneLocalChangeOfOriginalVertices) {
 TEST(Drill, RimChordsOnASheet) {
   // Flat sheets from coarse (the disc inside one face) to fine, random centres and radii: the
   // hole's boundary has at least min_rim_points vertices, all on the cylinder (computed ones
-  // to 1e-9, snapped ones within snap_fraction of an edge), no chord longer than the
-  // refinement's limit (1.2 × 2πr / min_rim_points, see below for snapped vertices), and the
-  // removed area within 2 % of πr².
+  // to 1e-9, snapped ones within 10 % of an edge), no chord longer than the refinement's
+  // limit (1.2 × 2πr / min_rim_points, see below for snapped vertices), the removed area
+  // within 2 % of πr², and the angle guarantee.
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
-  double worst_area = 0, worst_chord = 0, worst_snapped_chord = 0;
+  double worst_area = 0, worst_chord = 0, worst_snapped_chord = 0, worst_snap = 0;
+  AngleCheck angles;
   for (int trial = 0; trial < 300; ++trial) {
     const int n = 4 + trial % 37;
-    SkinnedMesh m = make_sheet(n, n, 2.0, 2.0);  // border at ±1, beyond every hole
+    const SkinnedMesh sheet = make_sheet(n, n, 2.0, 2.0);  // border at ±1, beyond every hole
+    SkinnedMesh m = sheet;
     const double a0 = surface_area(m), edge = longest_edge(m);
     Adjacency adj(m);
     const double r = 0.03 + 0.12 * std::abs(u(rng));
@@ -447,7 +534,10 @@ TEST(Drill, RimChordsOnASheet) {
         continue;  // the sheet's own border
       ++rim;
       const double ra = std::sqrt(axis_distance_squared(tool, a));
-      EXPECT_NEAR(ra, r, options.snap_fraction * edge + 1e-9) << what;
+      // Snapped vertices: within 10 % of an edge from a crossing point (drill.hpp), on the
+      // sheet at most 10 % of its longest edge from the cylinder.
+      worst_snap = std::max(worst_snap, std::abs(ra - r) / edge);
+      EXPECT_NEAR(ra, r, 0.1 * edge + 1e-9) << what;
       // The chord on Π (the drill's cross-section), where the limit applies. Between two
       // computed rim points (one face holds both) exactly; from a snapped vertex the rim point
       // it replaces may lie further along a nearly tangent edge: within twice the limit.
@@ -462,9 +552,13 @@ TEST(Drill, RimChordsOnASheet) {
     }
     EXPECT_GE(rim, options.min_rim_points) << what;
     expect_valid(m, what);
+    for (const TopologyChange& ch : d.changes) check_angles(sheet, m, ch, 0, angles);
     if (testing::Test::HasFailure()) break;
   }
+  EXPECT_GE(angles.worst_ratio, 1.0)
+      << "smallest angle " << angles.smallest * 180 / std::numbers::pi << " degrees";
   RecordProperty("worst_area_error", std::to_string(worst_area));
+  RecordProperty("worst_snap_over_edge", std::to_string(worst_snap));
   RecordProperty("worst_chord_over_limit", std::to_string(worst_chord));
   RecordProperty("worst_snapped_chord_over_limit", std::to_string(worst_snapped_chord));
 }

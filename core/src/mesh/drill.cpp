@@ -59,6 +59,25 @@ int edge_roots(const Eigen::Vector2d& mu, const Eigen::Vector2d& nu, double r2, 
   return count;
 }
 
+// The smallest angle of triangle (a, b, c), in radians: the one opposite its shortest edge.
+double smallest_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                      const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, bc = c - b, ca = a - c;
+  const double lab = ab.squaredNorm(), lbc = bc.squaredNorm(), lca = ca.squaredNorm();
+  const double twice_area = ab.cross(ca).norm();
+  if (lab <= lbc && lab <= lca) return std::atan2(twice_area, -ca.dot(bc));  // at c
+  if (lbc <= lca) return std::atan2(twice_area, -ab.dot(ca));                // at a
+  return std::atan2(twice_area, -ab.dot(bc));                                // at b
+}
+
+// The quad (p0, p1, p2, p3) split along p0–p2 (true) or p1–p3, whichever keeps the larger
+// smallest angle.
+bool split_02(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2,
+              const Eigen::Vector3d& p3) {
+  return std::min(smallest_angle(p0, p1, p2), smallest_angle(p0, p2, p3)) >=
+         std::min(smallest_angle(p0, p1, p3), smallest_angle(p1, p2, p3));
+}
+
 // Open addressing (linear probing, Fibonacci hashing) from a 64-bit key to an int32, for the
 // drill's scratch tables of a few dozen to a few thousand entries. No erase; clear() is O(1):
 // a slot is live only when stamped with the current epoch, so a table kept between drills
@@ -260,6 +279,7 @@ class Region {
     std::int32_t face;  // in the mesh
     bool modified = false;
     bool seed = false;  // pierced by the axis
+    double bound = -1;  // the angle guarantee's bound for its pieces (−1: not computed yet)
   };
 
   // One Region per thread is kept between drills, so that its tables are reused (a haptic
@@ -839,9 +859,6 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
       if (p.crossings < min_rim && pass < max_depth) p.limit *= 0.75, again = true;
     if (!again) break;
   }
-  int depth = 0;
-  for (const auto& lf : region.faces) depth = std::max(depth, int(lf.depth));
-  result.refinements = (depth + 1) / 2;
   for (const auto& p : patches)
     if (p.crossings > 0 && p.crossings < min_rim)
       result.message = "fewer rim points than min_rim_points after max_refinements";
@@ -854,20 +871,149 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
         edge_roots(region.verts[std::size_t(a)].q, region.verts[std::size_t(b)].q, axis.r2, roots);
     return n > 0 ? roots[0] : 0.5;
   };
-  for (std::size_t f = 0; f < region.faces.size(); ++f)
-    for (int k = 0; k < 3; ++k) {
-      const Region::LocalFace& lf = region.faces[f];
-      if (lf.twin[k] >= 0 && lf.twin[k] < std::int32_t(3 * f) + k) continue;  // each edge once
-      const std::int32_t a = std::min(lf.v[k], lf.v[(k + 1) % 3]),
-                         b = std::max(lf.v[k], lf.v[(k + 1) % 3]);
-      auto &va = region.verts[std::size_t(a)], &vb = region.verts[std::size_t(b)];
-      if (va.side * vb.side >= 0) continue;
-      const double t = crossing_t(a, b);
-      if (t < options.snap_fraction)
-        va.side = 0, ++result.snapped_rim_vertices;
-      else if (t > 1 - options.snap_fraction)
-        vb.side = 0, ++result.snapped_rim_vertices;
+  auto snap_near = [&] {
+    for (std::size_t f = 0; f < region.faces.size(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const Region::LocalFace& lf = region.faces[f];
+        if (lf.twin[k] >= 0 && lf.twin[k] < std::int32_t(3 * f) + k) continue;  // each edge once
+        const std::int32_t a = std::min(lf.v[k], lf.v[(k + 1) % 3]),
+                           b = std::max(lf.v[k], lf.v[(k + 1) % 3]);
+        auto &va = region.verts[std::size_t(a)], &vb = region.verts[std::size_t(b)];
+        if (va.side * vb.side >= 0) continue;
+        const double t = crossing_t(a, b);
+        if (t < options.snap_fraction)
+          va.side = 0, ++result.snapped_rim_vertices;
+        else if (t > 1 - options.snap_fraction)
+          vb.side = 0, ++result.snapped_rim_vertices;
+      }
+  };
+  // No slivers: every face the drill adds keeps its smallest angle at least
+  // min(min_angle_degrees, half the smallest angle of the original face it lies in). Rivara's
+  // bisection keeps half; a face the rim clips is cut into pieces (below) whose angles depend
+  // on where the rim crosses its edges: while a piece would be sharper than the bound, one more
+  // vertex of that face is taken as a rim vertex (snapped): the nearest to its crossing point
+  // of those whose snap leaves the face's pieces within the bound and whose crossing point is
+  // within kAngleSnap of the crossed edge from it. A snap changes the pieces of the faces
+  // around the vertex, hence the passes; every pass snaps at least one vertex for good, so
+  // they end. A face that no such snap mends is bisected (Rivara) and the classification
+  // starts again (at most kMendRounds times); in the last round the nearest vertex that
+  // mends the face is snapped however far (else the nearest), so that the bound holds.
+  const double angle_floor = std::max(options.min_angle_degrees, 0.0) * std::numbers::pi / 180;
+  auto crossing_x = [&](std::int32_t u, std::int32_t w) -> Eigen::Vector3d {
+    const std::int32_t a = std::min(u, w), b = std::max(u, w);
+    const double t = crossing_t(a, b);
+    return (1 - t) * region.verts[std::size_t(a)].x + t * region.verts[std::size_t(b)].x;
+  };
+  // The smallest angle of the pieces of local face f that stay (as emitted below); π when the
+  // rim does not clip f.
+  auto pieces_angle = [&](const std::array<std::int32_t, 3>& t) {
+    const auto& X = region.verts;
+    const int s[3] = {X[std::size_t(t[0])].side, X[std::size_t(t[1])].side,
+                      X[std::size_t(t[2])].side};
+    const bool in = s[0] < 0 || s[1] < 0 || s[2]<0, out = s[0]> 0 || s[1] > 0 || s[2] > 0;
+    if (!in || !out) return std::numbers::pi;
+    for (int k = 0; k < 3; ++k)
+      if (s[k] == 0) {
+        // The piece between the rim vertex, the outside vertex and the crossing.
+        const std::int32_t v0 = t[k], v1 = t[(k + 1) % 3], v2 = t[(k + 2) % 3];
+        const std::int32_t outside = X[std::size_t(v1)].side > 0 ? v1 : v2;
+        return smallest_angle(X[std::size_t(v0)].x, X[std::size_t(outside)].x, crossing_x(v1, v2));
+      }
+    int lone = 0;
+    for (int k = 0; k < 3; ++k)
+      if (s[(k + 1) % 3] == s[(k + 2) % 3]) lone = k;
+    const std::int32_t v0 = t[lone], v1 = t[(lone + 1) % 3], v2 = t[(lone + 2) % 3];
+    const Eigen::Vector3d x01 = crossing_x(v0, v1), x20 = crossing_x(v2, v0);
+    const Eigen::Vector3d &p0 = X[std::size_t(v0)].x, &p1 = X[std::size_t(v1)].x,
+                          &p2 = X[std::size_t(v2)].x;
+    if (s[lone] > 0) return smallest_angle(p0, x01, x20);
+    return split_02(x01, p1, p2, x20)
+               ? std::min(smallest_angle(x01, p1, p2), smallest_angle(x01, p2, x20))
+               : std::min(smallest_angle(x01, p1, x20), smallest_angle(p1, p2, x20));
+  };
+  auto bound = [&](const Region::LocalFace& lf) {
+    auto& o = region.origins[std::size_t(lf.origin)];
+    if (o.bound < 0) {
+      const Face& t = mesh.faces[std::size_t(o.face)];
+      o.bound =
+          std::min(angle_floor, 0.5 * smallest_angle(mesh.current.col(t[0]), mesh.current.col(t[1]),
+                                                     mesh.current.col(t[2])));
     }
+    return o.bound;
+  };
+  constexpr double kAngleSnap = 0.1;
+  constexpr int kMendRounds = 2;
+  auto& unmended = region.work;
+  for (int round = 0;; ++round) {
+    const bool last = round == kMendRounds;
+    if (round > 0) {  // after bisections: classify afresh
+      for (auto& v : region.verts) v.side = region.inside(v.q) ? -1 : 1;
+      result.snapped_rim_vertices = 0;
+    }
+    snap_near();
+    unmended.clear();
+    for (int pass = 0; angle_floor > 0 && pass < 64; ++pass) {
+      bool snapped = false;
+      unmended.clear();
+      for (std::size_t f = 0; f < region.faces.size(); ++f) {
+        const Region::LocalFace& lf = region.faces[f];
+        const double b = bound(lf);
+        if (pieces_angle(lf.v) >= b) continue;
+        // The candidates: the ends of the edges the rim crosses, by distance to the crossing
+        // (and that distance over the edge's length).
+        struct Candidate {
+          double distance2, fraction;
+          std::int32_t v;
+        };
+        std::array<Candidate, 3> candidates;
+        int count = 0;
+        for (int k = 0; k < 3; ++k) {
+          const std::int32_t v = lf.v[k];
+          const auto& x = region.verts[std::size_t(v)];
+          if (x.side == 0) continue;
+          Candidate c{std::numeric_limits<double>::infinity(), 1, v};
+          for (const std::int32_t w : {lf.v[(k + 1) % 3], lf.v[(k + 2) % 3]})
+            if (region.verts[std::size_t(w)].side == -x.side) {
+              const double d2 = (crossing_x(v, w) - x.x).squaredNorm();
+              if (d2 < c.distance2)
+                c.distance2 = d2,
+                c.fraction = std::sqrt(d2 / (region.verts[std::size_t(w)].x - x.x).squaredNorm());
+            }
+          if (c.distance2 < std::numeric_limits<double>::infinity()) candidates[count++] = c;
+        }
+        if (count == 0) continue;
+        std::sort(candidates.begin(), candidates.begin() + count,
+                  [](const Candidate& x, const Candidate& y) { return x.distance2 < y.distance2; });
+        std::int32_t pick = last ? candidates[0].v : -1;
+        for (int c = 0; c < count; ++c) {
+          if (!last && candidates[c].fraction > kAngleSnap) continue;
+          auto& side = region.verts[std::size_t(candidates[c].v)].side;
+          const int was = side;
+          side = 0;
+          const bool mends = pieces_angle(lf.v) >= b;
+          side = was;
+          if (mends) {
+            pick = candidates[c].v;
+            break;
+          }
+        }
+        if (pick < 0) {
+          unmended.push_back(std::int32_t(f));
+          continue;
+        }
+        region.verts[std::size_t(pick)].side = 0;
+        ++result.snapped_rim_vertices;
+        snapped = true;
+      }
+      if (!snapped) break;
+    }
+    if (unmended.empty() || last) break;
+    const std::vector<std::int32_t> mend(unmended.begin(), unmended.end());
+    for (auto f : mend) region.refine(f);
+  }
+  int depth = 0;
+  for (const auto& lf : region.faces) depth = std::max(depth, int(lf.depth));
+  result.refinements = (depth + 1) / 2;
   // Faces with a vertex inside are removed (2) or, with one outside too, clipped (1).
   auto& fate = region.fate;
   fate.assign(region.faces.size(), 0);
@@ -950,8 +1096,8 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
         keep(v0, x01, x20), cut(x01, x20);
       } else {
         const auto& X = region.verts;
-        if ((X[std::size_t(x01)].x - X[std::size_t(v2)].x).squaredNorm() <=
-            (X[std::size_t(v1)].x - X[std::size_t(x20)].x).squaredNorm())
+        if (split_02(X[std::size_t(x01)].x, X[std::size_t(v1)].x, X[std::size_t(v2)].x,
+                     X[std::size_t(x20)].x))
           keep(x01, v1, v2), keep(x01, v2, x20);
         else
           keep(x01, v1, x20), keep(v1, v2, x20);

@@ -19,9 +19,22 @@
 //      leaving the disc between two outside vertices is then a chord within the limit and is
 //      left whole (the area it cuts off is at most an inscribed chord's shortfall). Faces the
 //      rim does not cross are not refined;
-//   5. the inside is removed and the rim re-triangulated (split triangles stay triangles).
+//   5. the inside is removed and the rim re-triangulated (split triangles stay triangles; a
+//      clipped face's quad is split along the diagonal that keeps the larger smallest angle).
 // Vertices closer to the cylinder than snap_fraction of an edge are taken as rim vertices (not
-// moved), so there are no slivers; the computed rim points lie on the cylinder to rounding.
+// moved); the computed rim points lie on the cylinder to rounding.
+// Angle guarantee (no slivers): every face the drill adds to the surface has its smallest
+// angle at least min(min_angle_degrees, half the smallest angle of the original face it lies
+// in) (the tube walls are exempt, see below). Refinement keeps half (Rivara). Where a piece of a
+// clipped face would be sharper, one more vertex of that face is snapped: the nearest to its
+// crossing point among those whose snap mends the face and whose crossing point lies within
+// 10 % of the crossed edge from it; a face that no such snap mends is bisected and the
+// classification made again (twice at most; then the nearest mending vertex is snapped
+// however far: never seen in the property tests). The floor, 1°, is set by evidence, on the
+// random drills of the tests (arm, sheets, sphere): at 1° holes stay within 1.3 % of πr² and
+// snapped vertices within 1.4 % of the sheet's edge of the cylinder; 2° holds too but takes
+// holes to 1.85 % (of the 2 % budget) and snaps to 3.1 %; 3° breaks the 2 % (and the tube's
+// volume). Without the guarantee the drilled arm's smallest angle was 0.12°.
 // Refinement, holes and tube walls are ONE TopologyChange, applied once: every new vertex of
 // the holes is a combination of the corners of the original face (or edge) it lies in
 // (NewVertex::in_face / on_edge), so rest positions, weights, UVs and normals follow in one
@@ -33,7 +46,10 @@
 //      the drill enters and the next along the axis where it leaves, are joined by a tube wall:
 //      the two rim loops are stitched by a strip of triangles that walks both loops by angle
 //      around the axis (no new vertices: the tube's corners are the rim vertices), oriented as
-//      the surface, so that a closed input stays closed. A pair whose rims are not two simple
+//      the surface, so that a closed input stays closed. Its faces are exempt from the angle
+//      guarantee: without rings each spans the whole wall (a needle of the wall's length over
+//      the rim spacing, by design); with rings they are about as long as wide, their worst
+//      angles set by the rims' shortest edges. A pair whose rims are not two simple
 //      loops winding once around the axis, or share a vertex, or whose strip would reuse an
 //      edge of the changed mesh, is left open (see message); these checks are made on the
 //      change before it is applied (its added faces, and the mesh's adjacency for edges
@@ -75,7 +91,8 @@ struct DrillOptions {
   int min_rim_points = 24;  // the paper uses 6; 24 keeps the hole's area within 2 % of πr²
   int max_refinements = 6;  // at most 2 × this many bisections of an original face
   double snap_fraction = 0.01;
-  bool tube = false;  // join entry and exit holes of a closed surface with a tube wall
+  double min_angle_degrees = 1.0;  // the angle guarantee's floor (see above); 0: no guarantee
+  bool tube = false;               // join entry and exit holes of a closed surface with a tube wall
   // With the tube: intermediate rings at most this many times the rims' mean edge length
   // apart (0: none, one triangle spans the wall). Ring vertices are new vertices on the
   // segments between the two rims (NewVertex::on_edge of rim vertices).
