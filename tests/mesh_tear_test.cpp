@@ -4,6 +4,7 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <set>
 
 #include "conform/cga/versor.hpp"
 #include "conform/mesh/analysis.hpp"
@@ -17,6 +18,64 @@ using namespace conform;
 using namespace conform::mesh;
 
 namespace {
+
+// The faces of `out` that are not faces of `in` (those an operation added), except `skip`,
+// each against the face of `in` it lies in (found geometrically: the input face containing
+// its centroid, on the current positions, which the operation did not move). Returns the
+// smallest angle (radians) of the added faces and the worst ratio of that angle to the
+// guarantee min(floor, half the smallest angle of the original face) (≥ 1: the guarantee holds).
+struct AngleReport {
+  double smallest = M_PI;      // smallest angle of an added face
+  double worst_ratio = 1e300;  // min over added faces of angle / guaranteed bound
+  int faces = 0;
+};
+AngleReport added_face_angles(const SkinnedMesh& in, const SkinnedMesh& out, double floor,
+                              const std::vector<Face>& skip = {}) {
+  auto key = [](Face f) {
+    std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
+    return f;
+  };
+  std::set<Face> old, skipped;
+  for (const Face& f : in.faces) old.insert(key(f));
+  for (const Face& f : skip) skipped.insert(key(f));
+  struct Orig {
+    Eigen::Vector3d a, b, c, centre;
+    double radius, angle;
+  };
+  std::vector<Orig> orig;
+  for (const Face& f : in.faces) {
+    Orig o{in.current.col(f[0]), in.current.col(f[1]), in.current.col(f[2]), {}, 0, 0};
+    o.centre = (o.a + o.b + o.c) / 3;
+    o.radius =
+        std::max({(o.a - o.centre).norm(), (o.b - o.centre).norm(), (o.c - o.centre).norm()});
+    o.angle = smallest_angle(o.a, o.b, o.c);
+    orig.push_back(o);
+  }
+  AngleReport r;
+  for (const Face& f : out.faces) {
+    if (old.count(key(f)) || skipped.count(key(f))) continue;
+    const Eigen::Vector3d a = out.current.col(f[0]), b = out.current.col(f[1]),
+                          c = out.current.col(f[2]), p = (a + b + c) / 3;
+    // The containing input face: smallest distance from p (barycentric clamp).
+    double best = 1e300, bound_angle = 0;
+    for (const Orig& o : orig) {
+      if ((p - o.centre).norm() > o.radius * (1 + 1e-9) + 1e-12) continue;
+      const Eigen::Vector3d n = (o.b - o.a).cross(o.c - o.a);
+      const double area2 = n.squaredNorm();
+      if (!(area2 > 0)) continue;
+      const double l0 = (o.c - o.b).cross(p - o.b).dot(n) / area2,
+                   l1 = (o.a - o.c).cross(p - o.c).dot(n) / area2, l2 = 1 - l0 - l1;
+      const double off = std::abs((p - o.a).dot(n)) / std::sqrt(area2) +
+                         std::max(0.0, -std::min({l0, l1, l2})) * o.radius;
+      if (off < best) best = off, bound_angle = o.angle;
+    }
+    ++r.faces;
+    const double angle = smallest_angle(a, b, c);
+    r.smallest = std::min(r.smallest, angle);
+    r.worst_ratio = std::min(r.worst_ratio, angle / std::min(floor, bound_angle / 2));
+  }
+  return r;
+}
 
 double border_length(const SkinnedMesh& m, const std::vector<std::int32_t>& b) {
   double l = 0;
@@ -53,6 +112,15 @@ void expect_torn(const SkinnedMesh& m, const SkinnedMesh& in, const Tear& tear,
   for (Eigen::Index v = 0; v < m.weights.cols() && bad < 0; ++v)
     if (std::abs(m.weights.col(v).sum() - 1.0) > 1e-12) bad = v;
   EXPECT_EQ(bad, -1) << what;
+  // Slivers: the smallest angle of the faces the tear added. The guarantee of the cut,
+  // min(kTearMinAngle, half the original face's smallest angle), holds for each single split
+  // but not yet across steps (a later step may split a face an earlier one made); this
+  // asserts what is measured over the property tests (0.65° at worst, on the sphere; 0.014°
+  // before the tear placed its points by angle).
+  const AngleReport ar = added_face_angles(in, m, kTearMinAngle);
+  EXPECT_GE(ar.smallest, 0.5 * M_PI / 180) << what << ": a sliver";
+  if (std::getenv("TEAR_ANGLES"))
+    std::printf("ANGLE %s %.4f %.4f\n", what.c_str(), ar.smallest * 180 / M_PI, ar.worst_ratio);
 }
 
 ScalpelSample vertical(double t, double x, double y) {
@@ -68,7 +136,9 @@ TEST(Tear, StraightTearAcrossASheetIsOneContinuousTear) {
   Tear tear(m, adj);
   for (int i = 0; i < 100; ++i) tear.advance(vertical(i, -0.3 + 0.6 * i / 99.0, 0.0371));
   EXPECT_EQ(tear.steps(), 99) << tear.message();
-  EXPECT_NEAR(tear.length(), 0.6, 0.006);  // through snapped vertices: not quite straight
+  // Through snapped vertices, and edge points kept where they make no slivers (off Π by up to
+  // a few % of an edge): not quite straight.
+  EXPECT_NEAR(tear.length(), 0.6, 0.012);
   EXPECT_GT(tear.path_length(), 24 + 2);
   expect_torn(m, in, tear, "straight");
   // The adjacency kept up to date equals a fresh one.
@@ -145,6 +215,7 @@ TEST(Tear, PropertyRandomScalpelPaths) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);
   int extended = 0, attempted = 0;
+  double smallest_sheet = M_PI, smallest_sphere = M_PI;
   for (int trial = 0; trial < 300; ++trial) {
     const bool sheet = trial % 2 == 0;
     const SkinnedMesh in = sheet ? make_sheet(30, 30) : make_icosphere(3);
@@ -172,9 +243,14 @@ TEST(Tear, PropertyRandomScalpelPaths) {
       heading += turn;
     }
     expect_torn(m, in, tear, (sheet ? "sheet " : "sphere ") + std::to_string(trial));
+    const double a = added_face_angles(in, m, kTearMinAngle).smallest;
+    (sheet ? smallest_sheet : smallest_sphere) =
+        std::min(sheet ? smallest_sheet : smallest_sphere, a);
     if (testing::Test::HasFailure()) break;
   }
   EXPECT_GT(extended, attempted * 8 / 10);
+  RecordProperty("smallest_added_angle_deg_sheet", std::to_string(smallest_sheet * 180 / M_PI));
+  RecordProperty("smallest_added_angle_deg_sphere", std::to_string(smallest_sphere * 180 / M_PI));
 }
 
 TEST(Tear, ReDeformation) {

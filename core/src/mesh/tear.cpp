@@ -61,14 +61,81 @@ std::vector<std::int32_t> fan(const Adjacency& adj, std::int32_t h) {
   return out;
 }
 
+// The quad (a, b, c, d) split along the diagonal (a, c) or (b, d), whichever gives the larger
+// smallest angle (the first on a tie).
+bool first_diagonal(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                    const Eigen::Vector3d& d) {
+  return std::min(smallest_angle_sin2(a, b, c), smallest_angle_sin2(a, c, d)) >=
+         std::min(smallest_angle_sin2(a, b, d), smallest_angle_sin2(b, c, d));
+}
+
+// The edge parameters t (from x to y) at which a point of edge (x, y) is seen from the vertex
+// opposite the edge, in each face holding it, at least `angle` of that face away from both
+// ends (angle: the face's sliver bound). A point in that range splits those faces, from their
+// opposite vertices, into triangles that keep the bound; an empty range gives its middle.
+std::pair<double, double> safe_range(const SkinnedMesh& mesh, const Adjacency& adj, std::int32_t x,
+                                     std::int32_t y, double floor) {
+  double lo = 0, hi = 1;
+  const Eigen::Vector3d px = mesh.current.col(x), py = mesh.current.col(y);
+  const double len = (py - px).norm();
+  if (!(len > 0)) return {0.5, 0.5};
+  for (const std::int32_t h : {adj.find(x, y), adj.find(y, x)}) {
+    if (h < 0) continue;
+    const Face& f = mesh.faces[static_cast<std::size_t>(h / 3)];
+    const std::int32_t o = f[(h % 3 + 2) % 3];
+    const Eigen::Vector3d po = mesh.current.col(o);
+    auto angle = [](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+      return std::atan2(u.cross(v).norm(), u.dot(v));
+    };
+    const double ax = angle(py - px, po - px), ay = angle(px - py, po - py);
+    // The split angle at o: at least min(floor, half of it) on each side (for an input face,
+    // at least its sliver bound; for a face the tear made, no less than it can be).
+    const double b = std::min(floor, (std::numbers::pi - ax - ay) / 2);
+    // Sine rule in (o, x, q) with the angle b at o: |x q| = |o x| sin b / sin(ax + b).
+    const double sx = std::sin(ax + b), sy = std::sin(ay + b);
+    if (sx > 0) lo = std::max(lo, (po - px).norm() * std::sin(b) / sx / len);
+    if (sy > 0) hi = std::min(hi, 1 - (po - py).norm() * std::sin(b) / sy / len);
+  }
+  if (lo > hi) lo = hi = (lo + hi) / 2;
+  return {lo, hi};
+}
+
+// A point inside the polygon `poly` (a face with at most one edge point) for the fan of
+// triangles (poly[i], poly[i + 1], tip): the barycentric `bary` in the face (a, b, c) moved
+// toward the face's incenter, by the first of a few steps that gives every fan triangle its
+// smallest angle ≥ the face's sliver bound (the step with the best fan if none does).
+std::array<double, 3> place_tip(const std::array<double, 3>& bary, const Eigen::Vector3d& a,
+                                const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                                const std::vector<Eigen::Vector3d>& poly, double floor) {
+  const double la = (c - b).norm(), lb = (a - c).norm(), lc = (b - a).norm(), p = la + lb + lc;
+  if (!(p > 0)) return bary;
+  const std::array<double, 3> in{la / p, lb / p, lc / p};
+  const double bound = sliver_bound_sin2(a, b, c, floor);
+  std::array<double, 3> best = bary;
+  double best_q = -1;
+  for (const double lambda : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+    std::array<double, 3> w;
+    for (int k = 0; k < 3; ++k) w[k] = (1 - lambda) * bary[k] + lambda * in[k];
+    const Eigen::Vector3d tip = w[0] * a + w[1] * b + w[2] * c;
+    double q = 1;
+    for (std::size_t i = 0; i < poly.size(); ++i)
+      q = std::min(q, smallest_angle_sin2(poly[i], poly[(i + 1) % poly.size()], tip));
+    if (q >= bound) return w;
+    if (q > best_q) best_q = q, best = w;
+  }
+  return best;
+}
+
 }  // namespace
 
 Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, const TearOptions& options)
     : mesh_(mesh), adjacency_(adjacency), options_(options) {
   if (!adjacency.matches(mesh))
     throw std::invalid_argument("tear: the adjacency does not describe this mesh");
-  if (!(options.snap_fraction > 0 && options.snap_fraction < 0.25))
-    throw std::invalid_argument("tear: snap_fraction must be in (0, 0.25)");
+  if (!(options.snap_fraction > 0 && options.snap_fraction < 0.25) ||
+      !(options.min_angle >= 0 && options.min_angle < 0.5))
+    throw std::invalid_argument(
+        "tear: snap_fraction must be in (0, 0.25) and min_angle in [0, 0.5)");
 }
 
 Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex& index, const TearOptions& options)
@@ -110,6 +177,12 @@ bool Tear::start(const ScalpelSample& s, TearStep& step) {
   const double sum = bary[0] + bary[1] + bary[2];
   for (auto& x : bary) x /= sum;
   const Face f = mesh_.faces[static_cast<std::size_t>(hit)];
+  {
+    const Eigen::Vector3d a = mesh_.current.col(f[0]), b = mesh_.current.col(f[1]),
+                          c = mesh_.current.col(f[2]);
+    tip_target_ = bary[0] * a + bary[1] * b + bary[2] * c;
+    bary = place_tip(bary, a, b, c, {a, b, c}, options_.min_angle);
+  }
   TopologyChange ch;
   ch.base_vertex_count = mesh_.vertex_count();
   ch.base_face_count = mesh_.face_count();
@@ -190,11 +263,11 @@ TearStep Tear::advance(const ScalpelSample& s) {
     double t = dx / (dx - dy);
     if (t < snap) {
       if (snap_x) return out = {PathPoint::Vertex, x}, true;
-      t = snap;
     } else if (t > 1 - snap) {
       if (snap_y) return out = {PathPoint::Vertex, y}, true;
-      t = 1 - snap;
     }
+    const auto [lo, hi] = safe_range(mesh_, adjacency_, x, y, options_.min_angle);
+    t = std::clamp(t, std::max(lo, snap), std::max(std::min(hi, 1 - snap), std::max(lo, snap)));
     out = {PathPoint::Edge, -1, x, y, t};
     return true;
   };
@@ -262,7 +335,7 @@ TearStep Tear::advance(const ScalpelSample& s) {
                      mesh_.current.col(f[2]), raw);
     const Eigen::Vector3d at = raw[0] * mesh_.current.col(f[0]) + raw[1] * mesh_.current.col(f[1]) +
                                raw[2] * mesh_.current.col(f[2]);
-    if ((at - tip).norm() <= snap * size) {
+    if ((at - tip_target_).norm() <= snap * size) {  // where the blade was, not the placed tip
       unmoved = true;
     } else {
       path.push_back({face, {PathPoint::Vertex, tip_}, hit});
@@ -310,7 +383,10 @@ TearStep Tear::advance(const ScalpelSample& s) {
           if (t < snap) {
             out = {PathPoint::Vertex, z};
           } else {
-            t = std::min(t, 1 - snap);
+            // Off Π if need be, into the range where it makes no sliver on either side.
+            const auto [lo, hi] = safe_range(mesh_, adjacency_, z, w, options_.min_angle);
+            t = std::clamp(t, std::max(lo, snap),
+                           std::max(std::min(hi, 1 - snap), std::max(lo, snap)));
             out = {PathPoint::Edge, -1, z, w, t};
           }
         }
@@ -390,8 +466,22 @@ TearStep Tear::advance(const ScalpelSample& s) {
     return x;
   };
   std::vector<std::int32_t> points{tip_};
-  for (const Crossing& c : path) {
+  Eigen::Vector3d target = tip_target_;
+  for (Crossing& c : path) {
     const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
+    if (c.out.kind == PathPoint::Inside) {  // the new tip: no sliver in its fan
+      const Eigen::Vector3d fa = mesh_.current.col(f[0]), fb = mesh_.current.col(f[1]),
+                            fc = mesh_.current.col(f[2]);
+      std::vector<Eigen::Vector3d> ring;
+      for (int k = 0; k < 3; ++k) {
+        ring.push_back(mesh_.current.col(f[k]));
+        if (c.in.kind == PathPoint::Edge && ((c.in.a == f[k] && c.in.b == f[(k + 1) % 3]) ||
+                                             (c.in.b == f[k] && c.in.a == f[(k + 1) % 3])))
+          ring.push_back(pos(c.in, c.face));
+      }
+      target = pos(c.out, c.face);
+      c.out.bary = place_tip(c.out.bary, fa, fb, fc, ring, options_.min_angle);
+    }
     const std::int32_t in = id_of(c.in, c.face), out = id_of(c.out, c.face);
     points.push_back(out);
     // The face as a polygon with the path's edge points inserted.
@@ -426,9 +516,9 @@ TearStep Tear::advance(const ScalpelSample& s) {
       }
       if (sub.size() == 3) {
         a.added_faces.push_back({sub[0], sub[1], sub[2]});
-      } else {  // a quad: along its shorter diagonal
-        if ((position_of(sub[0]) - position_of(sub[2])).squaredNorm() <=
-            (position_of(sub[1]) - position_of(sub[3])).squaredNorm()) {
+      } else {  // a quad: along the diagonal with the larger smallest angle
+        if (first_diagonal(position_of(sub[0]), position_of(sub[1]), position_of(sub[2]),
+                           position_of(sub[3]))) {
           a.added_faces.push_back({sub[0], sub[1], sub[2]});
           a.added_faces.push_back({sub[0], sub[2], sub[3]});
         } else {
@@ -503,6 +593,7 @@ TearStep Tear::advance(const ScalpelSample& s) {
     path_.push_back({points[j], j + 1 < points.size() ? dups[j] : -1, left_dir[j]});
   tip_neighbor_ = points[points.size() - 2];
   tip_ = points.back();
+  tip_target_ = target;
   ++steps_;
   step.extended = true;
   message_.clear();
