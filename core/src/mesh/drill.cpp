@@ -59,15 +59,18 @@ int edge_roots(const Eigen::Vector2d& mu, const Eigen::Vector2d& nu, double r2, 
   return count;
 }
 
-// The smallest angle of triangle (a, b, c), in radians: the one opposite its shortest edge.
+// The tangent of the smallest angle of triangle (a, b, c): the angle opposite its shortest
+// edge, at most 60°, so that its tangent orders angles without trigonometry.
 double smallest_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                       const Eigen::Vector3d& c) {
   const Eigen::Vector3d ab = b - a, bc = c - b, ca = a - c;
   const double lab = ab.squaredNorm(), lbc = bc.squaredNorm(), lca = ca.squaredNorm();
   const double twice_area = ab.cross(ca).norm();
-  if (lab <= lbc && lab <= lca) return std::atan2(twice_area, -ca.dot(bc));  // at c
-  if (lbc <= lca) return std::atan2(twice_area, -ab.dot(ca));                // at a
-  return std::atan2(twice_area, -ab.dot(bc));                                // at b
+  const double dot = lab <= lbc && lab <= lca ? -ca.dot(bc)  // at c
+                     : lbc <= lca             ? -ab.dot(ca)  // at a
+                                              : -ab.dot(bc);             // at b
+  if (dot > 0) return twice_area / dot;
+  return twice_area > 0 ? std::numeric_limits<double>::infinity() : 0;
 }
 
 // The quad (p0, p1, p2, p3) split along p0–p2 (true) or p1–p3, whichever keeps the larger
@@ -267,6 +270,7 @@ class Region {
     int side = 1;             // +1 outside, −1 inside, 0 on the cylinder (snapped)
     bool rim = false;         // a new vertex on the cylinder
     bool loop = false;        // on a rim loop kept for the tube
+    int snapped = -1;         // the angle pass that snapped it (64 × round + pass), or −1
   };
   struct LocalFace {
     std::array<std::int32_t, 3> v;
@@ -279,7 +283,7 @@ class Region {
     std::int32_t face;  // in the mesh
     bool modified = false;
     bool seed = false;  // pierced by the axis
-    double bound = -1;  // the angle guarantee's bound for its pieces (−1: not computed yet)
+    double bound = -1;  // tangent of the angle guarantee's bound (−1: not computed yet)
   };
 
   // One Region per thread is kept between drills, so that its tables are reused (a haptic
@@ -289,7 +293,7 @@ class Region {
     verts.clear(), faces.clear(), origins.clear(), touched.clear();
     vertex_of_.clear(), face_of_.clear(), pending_.clear();
     work.clear(), fate.clear(), added.clear(), hole_edges.clear();
-    crossing_vertex.clear(), next.clear(), rim_edges.clear(), new_x.clear();
+    crossing_vertex.clear(), next.clear(), rim_edges.clear(), new_x.clear(), clipped.clear();
   }
 
   std::vector<Vertex> verts;
@@ -521,6 +525,7 @@ class Region {
   std::vector<std::array<std::int32_t, 3>> hole_edges;
   FlatMap crossing_vertex{64}, next{64}, rim_edges{64}, in_a{64};
   std::vector<Eigen::Vector3d> new_x;
+  std::vector<std::int32_t> clipped;
 
  private:
   void link(std::int32_t h, std::int32_t t) {
@@ -904,14 +909,14 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     const double t = crossing_t(a, b);
     return (1 - t) * region.verts[std::size_t(a)].x + t * region.verts[std::size_t(b)].x;
   };
-  // The smallest angle of the pieces of local face f that stay (as emitted below); π when the
-  // rim does not clip f.
+  // The smallest angle of the pieces of local face f that stay (as emitted below), as its
+  // tangent (smallest_angle); +∞ when the rim does not clip f.
   auto pieces_angle = [&](const std::array<std::int32_t, 3>& t) {
     const auto& X = region.verts;
     const int s[3] = {X[std::size_t(t[0])].side, X[std::size_t(t[1])].side,
                       X[std::size_t(t[2])].side};
     const bool in = s[0] < 0 || s[1] < 0 || s[2]<0, out = s[0]> 0 || s[1] > 0 || s[2] > 0;
-    if (!in || !out) return std::numbers::pi;
+    if (!in || !out) return std::numeric_limits<double>::infinity();
     for (int k = 0; k < 3; ++k)
       if (s[k] == 0) {
         // The piece between the rim vertex, the outside vertex and the crossing.
@@ -935,9 +940,9 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     auto& o = region.origins[std::size_t(lf.origin)];
     if (o.bound < 0) {
       const Face& t = mesh.faces[std::size_t(o.face)];
-      o.bound =
-          std::min(angle_floor, 0.5 * smallest_angle(mesh.current.col(t[0]), mesh.current.col(t[1]),
-                                                     mesh.current.col(t[2])));
+      const double original = std::atan(
+          smallest_angle(mesh.current.col(t[0]), mesh.current.col(t[1]), mesh.current.col(t[2])));
+      o.bound = std::tan(std::min(angle_floor, 0.5 * original));  // as a tangent
     }
     return o.bound;
   };
@@ -952,11 +957,28 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     }
     snap_near();
     unmended.clear();
-    for (int pass = 0; angle_floor > 0 && pass < 64; ++pass) {
-      bool snapped = false;
-      unmended.clear();
+    // Only clipped faces make pieces, and a snap never clips a face that was not: after the
+    // first pass, only the clipped faces with a vertex snapped in the pass before are seen.
+    auto& clipped = region.clipped;
+    clipped.clear();
+    if (angle_floor > 0)
       for (std::size_t f = 0; f < region.faces.size(); ++f) {
-        const Region::LocalFace& lf = region.faces[f];
+        bool in = false, out = false;
+        for (auto v : region.faces[f].v) {
+          in = in || region.verts[std::size_t(v)].side < 0;
+          out = out || region.verts[std::size_t(v)].side > 0;
+        }
+        if (in && out) clipped.push_back(std::int32_t(f));
+      }
+    for (int pass = 0; pass < 64; ++pass) {
+      bool snapped = false;
+      const int stamp = 64 * round + pass;
+      for (const std::int32_t f : clipped) {
+        const Region::LocalFace& lf = region.faces[std::size_t(f)];
+        if (pass > 0 && region.verts[std::size_t(lf.v[0])].snapped != stamp - 1 &&
+            region.verts[std::size_t(lf.v[1])].snapped != stamp - 1 &&
+            region.verts[std::size_t(lf.v[2])].snapped != stamp - 1)
+          continue;
         const double b = bound(lf);
         if (pieces_angle(lf.v) >= b) continue;
         // The candidates: the ends of the edges the rim crosses, by distance to the crossing
@@ -998,17 +1020,25 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
           }
         }
         if (pick < 0) {
-          unmended.push_back(std::int32_t(f));
+          unmended.push_back(f);
           continue;
         }
         region.verts[std::size_t(pick)].side = 0;
+        region.verts[std::size_t(pick)].snapped = stamp;
         ++result.snapped_rim_vertices;
         snapped = true;
       }
       if (!snapped) break;
     }
-    if (unmended.empty() || last) break;
-    const std::vector<std::int32_t> mend(unmended.begin(), unmended.end());
+    if (last) break;
+    // The faces still unmended (a later snap may have mended one).
+    std::vector<std::int32_t> mend;
+    for (const std::int32_t f : unmended)
+      if (pieces_angle(region.faces[std::size_t(f)].v) < bound(region.faces[std::size_t(f)]))
+        mend.push_back(f);
+    if (mend.empty()) break;
+    std::sort(mend.begin(), mend.end());
+    mend.erase(std::unique(mend.begin(), mend.end()), mend.end());
     for (auto f : mend) region.refine(f);
   }
   int depth = 0;
