@@ -174,13 +174,16 @@ std::vector<std::int32_t> Pieces::faces_of(std::int32_t p) const {
 
 Pieces label_pieces(const SkinnedMesh& mesh) {
   // Union–find over the vertices where every root is the lowest vertex of its set: linking
-  // always hangs the higher root under the lowest, and path halving only shortcuts to
-  // ancestors, so parent[v] < v for every non-root v. One increasing pass then compresses
-  // every path completely.
+  // always hangs the higher roots under the lowest, r, and compression only points a vertex at
+  // an ancestor, so parent[v] < v for every non-root v. Each face also points its own
+  // vertices straight at r (full compression of the paths just walked: the next faces around
+  // them find r in one or two loads). One increasing pass then compresses every path. The
+  // scratch arrays are kept per thread between calls (no allocation at haptic rates).
   const auto nv = static_cast<std::size_t>(mesh.vertex_count());
-  std::vector<std::int32_t> parent(nv);
-  std::iota(parent.begin(), parent.end(), 0);
+  thread_local std::vector<std::int32_t> parent, label;
+  if (parent.size() < nv) parent.resize(nv), label.resize(nv);
   std::int32_t* const par = parent.data();
+  std::iota(par, par + nv, 0);
   auto find = [par](std::int32_t x) {
     for (;;) {
       const std::int32_t p = par[x];
@@ -192,16 +195,20 @@ Pieces label_pieces(const SkinnedMesh& mesh) {
     }
   };
   for (const Face& f : mesh.faces) {
-    std::int32_t a = find(f[0]), b = find(f[1]), c = find(f[2]);
+    // Three independent loads settle the usual face, whose vertices already share a parent.
+    const std::int32_t p0 = par[f[0]];
+    if (p0 == par[f[1]] && p0 == par[f[2]]) continue;
+    const std::int32_t a = find(f[0]), b = find(f[1]), c = find(f[2]);
     if (a == b && b == c) continue;
     const std::int32_t r = std::min(a, std::min(b, c));
     par[a] = r, par[b] = r, par[c] = r;
+    par[f[0]] = r, par[f[1]] = r, par[f[2]] = r;
   }
   for (std::size_t v = 0; v < nv; ++v) par[v] = par[par[v]];
   Pieces p;
   p.face_piece.resize(mesh.faces.size());
-  std::vector<std::int32_t> label(nv, -1);
   std::int32_t* const lab = label.data();
+  std::fill(lab, lab + nv, -1);
   std::int32_t* const out = p.face_piece.data();
   std::int32_t count = 0;
   for (std::size_t f = 0; f < mesh.faces.size(); ++f) {

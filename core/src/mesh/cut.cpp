@@ -42,6 +42,27 @@ QuadSplit best_quad_split(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
   return q1 >= q2 ? QuadSplit{true, q1} : QuadSplit{false, q2};
 }
 
+// compute_cut's working arrays, kept per thread between calls so that a cut at haptic rates
+// allocates only what it returns.
+struct Scratch {
+  std::vector<double> dist;
+  std::vector<std::int8_t> side;
+  std::vector<std::uint8_t> code;
+  std::vector<std::int32_t> work, crossed, evaluate, again, snapped_now, parent, xcopy,
+      plane_vertices, copy_plus, copy_minus, next, starts, ids, loop;
+  EdgeMap crossing;
+  std::vector<Eigen::Vector3d> xpos;
+  std::vector<Pending> pending;
+  std::vector<std::pair<std::int32_t, std::int32_t>> on_plane;
+  std::vector<std::array<std::int32_t, 3>> pending_local;
+  std::vector<std::uint8_t> ambiguous, visited;
+  std::vector<std::uint64_t> plus_edges;
+};
+Scratch& scratch() {
+  thread_local Scratch s;
+  return s;
+}
+
 std::int32_t root(std::vector<std::int32_t>& p, std::int32_t x) {
   while (p[static_cast<std::size_t>(x)] != x)
     x = p[static_cast<std::size_t>(x)] =
@@ -83,7 +104,9 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   // One pass over the positions: finite, their bounding box (the tolerance's scale), step 1's
   // signed distances (the same predicates as classify_vertices) and the farthest vertex on
   // each side.
-  std::vector<double> dist(static_cast<std::size_t>(nv0));
+  Scratch& sc = scratch();
+  std::vector<double>& dist = sc.dist;
+  dist.resize(static_cast<std::size_t>(nv0));
   double diagonal = 0, reach_pos = 0, reach_neg = 0;
   if (nv0 > 0) {
     const double* x = mesh.current.data();
@@ -133,8 +156,10 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   const double snap = options.snap_fraction;
   const double k_snap = snap / (1 - snap) * (1 + 1e-9);  // a margin for rounding
   const double near_pos = k_snap * reach_neg, near_neg = k_snap * reach_pos;
-  std::vector<std::int8_t> side(static_cast<std::size_t>(nv0));
-  std::vector<std::uint8_t> code(static_cast<std::size_t>(nv0));
+  std::vector<std::int8_t>& side = sc.side;
+  std::vector<std::uint8_t>& code = sc.code;
+  side.resize(static_cast<std::size_t>(nv0));
+  code.resize(static_cast<std::size_t>(nv0));
   for (std::int32_t i = 0; i < nv0; ++i) {
     const double s = dist[static_cast<std::size_t>(i)];
     const std::int8_t si = s > eps ? 1 : (s < -eps ? -1 : 0);
@@ -152,7 +177,8 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   const Face* const faces = mesh.faces.data();
   std::int8_t* const sd = side.data();
   const std::uint8_t* const cd = code.data();
-  std::vector<std::int32_t> work;
+  std::vector<std::int32_t>& work = sc.work;
+  work.clear();
   work.reserve(256);
   bool face_pos = false, face_neg = false;
   {
@@ -217,8 +243,9 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     return std::min(smallest_angle_sin2(p0, x01, x20), best_quad_split(x01, p1, p2, x20).quality);
   };
   const double floor_sin2 = std::sin(options.min_angle) * std::sin(options.min_angle);
-  std::vector<std::int32_t> crossed, evaluate, again;
-  std::vector<std::int32_t> snapped_now;
+  std::vector<std::int32_t>&crossed = sc.crossed, &evaluate = sc.evaluate, &again = sc.again,
+  &snapped_now = sc.snapped_now;
+  crossed.clear(), evaluate.clear(), again.clear(), snapped_now.clear();
   bool outside_work = false;  // a vertex not flagged near was snapped: its faces are not in work
   for (const std::int32_t fi : work) {
     const Face& f = faces[fi];
@@ -300,10 +327,12 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   }
 
   TopologyChange& ch = result.change;
-  EdgeMap crossing;  // (lower, higher) vertex → crossing vertex id
+  EdgeMap& crossing = sc.crossing;  // (lower, higher) vertex → crossing vertex id
+  crossing.clear();
   crossing.reserve(2 * work.size());
   ch.new_vertices.reserve(2 * work.size());
-  std::vector<Eigen::Vector3d> xpos;
+  std::vector<Eigen::Vector3d>& xpos = sc.xpos;
+  xpos.clear();
   xpos.reserve(work.size());
   auto cross_vertex = [&](std::int32_t u, std::int32_t w) {
     const std::int32_t a = std::min(u, w), b = std::max(u, w);
@@ -322,10 +351,12 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     return v < nv0 ? Eigen::Vector3d(mesh.current.col(v)) : xpos[static_cast<std::size_t>(v - nv0)];
   };
 
-  std::vector<Pending> pending;
+  std::vector<Pending>& pending = sc.pending;
+  pending.clear();
   pending.reserve(3 * work.size());
-  std::vector<std::pair<std::int32_t, std::int32_t>>
-      on_plane;  // (vertex on the plane, pending index)
+  std::vector<std::pair<std::int32_t, std::int32_t>>& on_plane =
+      sc.on_plane;  // (vertex on the plane, pending index)
+  on_plane.clear();
   std::vector<std::int32_t> split;
   split.reserve(work.size());
   const Eigen::Vector3d n = plane.normal();
@@ -392,7 +423,7 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   // Separate the fans around vertices on the plane: faces on one side sharing an edge through
   // the vertex form a fan; the first positive fan keeps the vertex, every other fan gets a copy.
   std::sort(on_plane.begin(), on_plane.end());
-  std::vector<std::int32_t> parent;
+  std::vector<std::int32_t>& parent = sc.parent;
   for (std::size_t i = 0; i < on_plane.size();) {
     std::size_t j = i;
     while (j < on_plane.size() && on_plane[j].first == on_plane[i].first) ++j;
@@ -440,7 +471,8 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   }
   // Crossing vertices: the negative side uses a copy.
   const auto nx = static_cast<std::int32_t>(xpos.size());
-  std::vector<std::int32_t> xcopy(static_cast<std::size_t>(nx));
+  std::vector<std::int32_t>& xcopy = sc.xcopy;
+  xcopy.resize(static_cast<std::size_t>(nx));
   for (std::int32_t k = 0; k < nx; ++k) {
     xcopy[static_cast<std::size_t>(k)] = nv0 + static_cast<std::int32_t>(ch.new_vertices.size());
     ch.new_vertices.push_back(NewVertex::duplicate(nv0 + k));
@@ -467,7 +499,8 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   // Caps. Loop vertices (crossing vertices, and original vertices on the plane) get compact
   // local ids — crossing vertex nv0 + k is k, the i-th vertex of `plane_vertices` is nx + i —
   // so that the loop bookkeeping is flat arrays rather than hash maps.
-  std::vector<std::int32_t> plane_vertices;
+  std::vector<std::int32_t>& plane_vertices = sc.plane_vertices;
+  plane_vertices.clear();
   plane_vertices.reserve(on_plane.size());
   for (const auto& [v, unused] : on_plane)
     if (plane_vertices.empty() || plane_vertices.back() != v) plane_vertices.push_back(v);
@@ -483,12 +516,15 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     return l < nx ? nv0 + l : plane_vertices[static_cast<std::size_t>(l - nx)];
   };
   // Per pending face, its vertices' local ids (−1 for others).
-  std::vector<std::array<std::int32_t, 3>> pending_local(pending.size());
+  std::vector<std::array<std::int32_t, 3>>& pending_local = sc.pending_local;
+  pending_local.resize(pending.size());
   for (std::size_t i = 0; i < pending.size(); ++i)
     for (int k = 0; k < 3; ++k) pending_local[i][k] = local(pending[i].pre[k]);
   // The id each side uses for a loop vertex; conflicting entries make a loop ambiguous.
-  std::vector<std::int32_t> copy_plus(nloop, -1), copy_minus(nloop, -1);
-  std::vector<std::uint8_t> ambiguous(nloop, 0);
+  std::vector<std::int32_t>&copy_plus = sc.copy_plus, &copy_minus = sc.copy_minus;
+  copy_plus.assign(nloop, -1), copy_minus.assign(nloop, -1);
+  std::vector<std::uint8_t>& ambiguous = sc.ambiguous;
+  ambiguous.assign(nloop, 0);
   for (std::size_t i = 0; i < pending.size(); ++i)
     for (int k = 0; k < 3; ++k) {
       const std::int32_t l = pending_local[i][k];
@@ -505,7 +541,8 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   auto edge_key = [](std::int32_t u, std::int32_t w) {
     return (std::uint64_t(std::uint32_t(u)) << 32) | std::uint32_t(w);
   };
-  std::vector<std::uint64_t> plus_edges;
+  std::vector<std::uint64_t>& plus_edges = sc.plus_edges;
+  plus_edges.clear();
   plus_edges.reserve(pending.size());
   for (std::size_t i = 0; i < pending.size(); ++i)
     if (pending[i].side > 0)
@@ -514,8 +551,10 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
         if (u >= 0 && w >= 0) plus_edges.push_back(edge_key(u, w));
       }
   std::sort(plus_edges.begin(), plus_edges.end());
-  std::vector<std::int32_t> next(nloop, -1);  // boundary edge u → next[u]
-  std::vector<std::int32_t> starts;
+  std::vector<std::int32_t>& next = sc.next;  // boundary edge u → next[u]
+  next.assign(nloop, -1);
+  std::vector<std::int32_t>& starts = sc.starts;
+  starts.clear();
   bool branching = false;
   for (const std::uint64_t e : plus_edges) {
     const auto u = static_cast<std::int32_t>(e >> 32),
@@ -528,14 +567,17 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
       to = w;
     starts.push_back(u);
   }
-  std::vector<std::uint8_t> visited(nloop, 0);
+  std::vector<std::uint8_t>& visited = sc.visited;
+  visited.assign(nloop, 0);
   std::vector<std::string> problems;
   // Every closed, unambiguous loop goes into one triangulation of the section, in the plane's
   // frame (e1, e2, n), so that loops inside loops make holes and islands.
   const Eigen::Vector3d e1 = n.unitOrthogonal(), e2 = n.cross(e1);
-  std::vector<std::int32_t> ids;  // the section's vertices (local ids), loops concatenated
+  std::vector<std::int32_t>& ids =
+      sc.ids;  // the section's vertices (local ids), loops concatenated
   std::vector<std::vector<Eigen::Vector2d>> loops2;
-  std::vector<std::int32_t> loop;
+  ids.clear();
+  std::vector<std::int32_t>& loop = sc.loop;
   for (auto s0 : starts) {
     if (visited[static_cast<std::size_t>(s0)]) continue;
     loop.clear();
