@@ -1036,6 +1036,38 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     for (const std::int32_t f : unmended)
       if (pieces_angle(region.faces[std::size_t(f)].v) < bound(region.faces[std::size_t(f)]))
         mend.push_back(f);
+    // A snapped vertex stands for a rim point up to an edge's length away: the rim's chords
+    // from it (on Π) may exceed the refinement's limit. Faces holding such a chord are
+    // bisected too: a clipped face with a rim vertex (the chord to its crossing) and a removed
+    // face with two (their edge).
+    for (std::size_t f = 0; f < region.faces.size(); ++f) {
+      const Region::LocalFace& lf = region.faces[f];
+      if (lf.depth >= max_depth) continue;
+      const auto& X = region.verts;
+      int zero = -1, zeros = 0, in = 0, out = 0;
+      for (int k = 0; k < 3; ++k) {
+        const int side = X[std::size_t(lf.v[k])].side;
+        if (side == 0) zero = k, ++zeros;
+        in += side<0, out += side> 0;
+      }
+      if (zeros == 0 || in == 0) continue;
+      double chord2 = 0;
+      if (zeros == 1 && out == 1) {
+        const std::int32_t v1 = lf.v[(zero + 1) % 3], v2 = lf.v[(zero + 2) % 3];
+        const std::int32_t a = std::min(v1, v2), b = std::max(v1, v2);
+        const double t = crossing_t(a, b);
+        chord2 = (X[std::size_t(lf.v[zero])].q -
+                  ((1 - t) * X[std::size_t(a)].q + t * X[std::size_t(b)].q))
+                     .squaredNorm();
+      } else if (zeros == 2) {
+        const std::int32_t u = lf.v[(zero + 1) % 3], w = lf.v[(zero + 2) % 3];
+        chord2 = X[std::size_t(u)].side == 0
+                     ? (X[std::size_t(lf.v[zero])].q - X[std::size_t(u)].q).squaredNorm()
+                     : (X[std::size_t(lf.v[zero])].q - X[std::size_t(w)].q).squaredNorm();
+      }
+      const double limit = patches[std::size_t(lf.patch)].limit;
+      if (chord2 > limit * limit) mend.push_back(std::int32_t(f));
+    }
     if (mend.empty()) break;
     std::sort(mend.begin(), mend.end());
     mend.erase(std::unique(mend.begin(), mend.end()), mend.end());

@@ -22,7 +22,11 @@
 //   5. the inside is removed and the rim re-triangulated (split triangles stay triangles; a
 //      clipped face's quad is split along the diagonal that keeps the larger smallest angle).
 // Vertices closer to the cylinder than snap_fraction of an edge are taken as rim vertices (not
-// moved); the computed rim points lie on the cylinder to rounding.
+// moved); the computed rim points lie on the cylinder to rounding. A snapped vertex stands
+// for a rim point up to an edge away: a face that would hold a rim chord from one longer than
+// the refinement's limit (on Π) is bisected and the classification made again (with the
+// angle mending below, twice at most, within max_refinements), so that snapped vertices do
+// not lengthen the rim polygon's chords either.
 // Angle guarantee (no slivers): every face the drill adds to the surface has its smallest
 // angle at least min(min_angle_degrees, half the smallest angle of the original face it lies
 // in) (the tube walls are exempt, see below). Refinement keeps half (Rivara). Where a piece of a
