@@ -221,12 +221,19 @@ void register_mesh_ops(CLI::App& app, Context& context) {
     auto tip = std::make_shared<std::vector<double>>();
     auto base = std::make_shared<std::vector<double>>();
     auto radius = std::make_shared<double>(0.0);
+    auto options = std::make_shared<mesh::DrillOptions>();
     auto* cmd = app.add_subcommand("drill", "Drill a cylindrical hole (Algorithm 3)");
     add_common(cmd, *common);
     cmd->add_option("--tip", *tip, "drill tip A: X Y Z")->expected(3)->required();
     cmd->add_option("--base", *base, "drill base B: X Y Z")->expected(3)->required();
     cmd->add_option("--radius", *radius, "drill radius (m)")->required();
-    cmd->callback([&context, common, tip, base, radius]() {
+    cmd->add_flag("--tube", options->tube,
+                  "join the entry and exit holes of a closed surface with a tube wall");
+    cmd->add_option("--tube-rings", options->tube_ring_spacing,
+                    "with --tube: rings of new vertices at most SPACING x the rims' mean edge "
+                    "apart (0: one triangle spans the wall)")
+        ->check(CLI::NonNegativeNumber);
+    cmd->callback([&context, common, tip, base, radius, options]() {
       run(context, "drill", [&] {
         nlohmann::json summary;
         summary["command"] = "drill";
@@ -237,8 +244,10 @@ void register_mesh_ops(CLI::App& app, Context& context) {
         mesh::Adjacency adjacency(m);
         const double t_adj = ms_since(t0);
         const auto t1 = Clock::now();
+        if (options->tube_ring_spacing > 0 && !options->tube)
+          throw std::runtime_error("--tube-rings needs --tube");
         const mesh::DrillResult r =
-            mesh::drill(m, adjacency, {{a[0], a[1], a[2]}, {b[0], b[1], b[2]}, *radius});
+            mesh::drill(m, adjacency, {{a[0], a[1], a[2]}, {b[0], b[1], b[2]}, *radius}, *options);
         summary["timing_ms"]["adjacency"] = t_adj;
         summary["timing_ms"]["operation"] = ms_since(t1);
         summary["holes"] = r.holes;
@@ -246,6 +255,7 @@ void register_mesh_ops(CLI::App& app, Context& context) {
         summary["removed_faces"] = r.removed_area_faces;
         summary["removed_area"] = r.removed_area;
         summary["refinements"] = r.refinements;
+        if (options->tube) summary["tube"] = {{"tubes", r.tubes}, {"faces", r.tube_faces}};
         if (!r.message.empty()) summary["message"] = r.message;
         if (r.holes == 0)
           throw std::runtime_error("the drill does not pierce the surface: " + r.message);

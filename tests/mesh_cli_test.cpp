@@ -73,7 +73,18 @@ TEST_F(MeshCli, DrillAndTear) {
                 d.string()),
             0);
   EXPECT_EQ(summary(d)["holes"], 2);
+  EXPECT_EQ(summary(d)["output"]["closed"], false);
   expect_only_outputs(d, 1, ".obj");
+  fs::remove_all(d);
+  // With the tube wall (and rings) the drilled arm stays closed.
+  ASSERT_EQ(run("drill arm --tip 0 -0.2 0.4 --base 0 0.2 0.4 --radius 0.01 --tube --tube-rings 2 "
+                "--out " +
+                d.string()),
+            0);
+  EXPECT_EQ(summary(d)["tube"]["tubes"], 1);
+  EXPECT_GT(summary(d)["tube"]["faces"], 66);
+  EXPECT_EQ(summary(d)["output"]["closed"], true);
+  EXPECT_EQ(summary(d)["output"]["manifold"], true);
   fs::remove_all(d);
 
   const fs::path t = fresh_dir("tear");
@@ -102,6 +113,9 @@ TEST_F(MeshCli, ErrorsExitNonZero) {
   EXPECT_NE(run("drill arm --tip 0 0 0 --base 0 0 1 --radius 0 --out " + d.string()), 0);
   EXPECT_NE(run("drill arm --tip 5 5 0 --base 5 5 1 --radius 0.01 --out " + d.string()),
             0);  // misses
+  EXPECT_NE(run("drill arm --tip 0 -0.2 0.4 --base 0 0.2 0.4 --radius 0.01 --tube-rings 2 --out " +
+                d.string()),
+            0);  // rings without a tube
   EXPECT_NE(run("tear missing_model.fbx --scalpel x.csv --out " + d.string()), 0);
   EXPECT_NE(run("cut arm --plane 0 0 nan 0 --out " + d.string()), 0);
   EXPECT_NE(run("cut arm --plane 0 0 1 --out " + d.string()), 0);  // three numbers
