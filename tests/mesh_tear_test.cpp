@@ -112,13 +112,12 @@ void expect_torn(const SkinnedMesh& m, const SkinnedMesh& in, const Tear& tear,
   for (Eigen::Index v = 0; v < m.weights.cols() && bad < 0; ++v)
     if (std::abs(m.weights.col(v).sum() - 1.0) > 1e-12) bad = v;
   EXPECT_EQ(bad, -1) << what;
-  // Slivers: the smallest angle of the faces the tear added. The guarantee of the cut,
-  // min(kTearMinAngle, half the original face's smallest angle), holds for each single split
-  // but not yet across steps (a later step may split a face an earlier one made); this
-  // asserts what is measured over the property tests (0.65° at worst, on the sphere; 0.014°
-  // before the tear placed its points by angle).
+  // No slivers: every face the tear added has smallest angle ≥ min(kTearMinAngle, half the
+  // smallest angle of the input face it lies in) (0.014° at worst before the tear placed its
+  // points by angle).
   const AngleReport ar = added_face_angles(in, m, kTearMinAngle);
-  EXPECT_GE(ar.smallest, 0.5 * M_PI / 180) << what << ": a sliver";
+  EXPECT_GE(ar.worst_ratio, 1 - 1e-9)
+      << what << ": a sliver of " << ar.smallest * 180 / M_PI << "°";
   if (std::getenv("TEAR_ANGLES"))
     std::printf("ANGLE %s %.4f %.4f\n", what.c_str(), ar.smallest * 180 / M_PI, ar.worst_ratio);
 }
@@ -135,7 +134,9 @@ TEST(Tear, StraightTearAcrossASheetIsOneContinuousTear) {
   Adjacency adj(m);
   Tear tear(m, adj);
   for (int i = 0; i < 100; ++i) tear.advance(vertical(i, -0.3 + 0.6 * i / 99.0, 0.0371));
-  EXPECT_EQ(tear.steps(), 99) << tear.message();
+  // Every sample extends the tear but those that would put the new tip in a thin face of the
+  // old tip's fan (they wait for the blade to move on: no slivers).
+  EXPECT_GE(tear.steps(), 90) << tear.message();
   // Through snapped vertices, and edge points kept where they make no slivers (off Π by up to
   // a few % of an edge): not quite straight.
   EXPECT_NEAR(tear.length(), 0.6, 0.012);
@@ -164,7 +165,7 @@ TEST(Tear, CurvedTearOnASheet) {
     const double a = 0.2 + 1.2 * std::numbers::pi * i / 99.0;
     tear.advance(vertical(i, 0.3 * std::cos(a), 0.3 * std::sin(a)));
   }
-  EXPECT_EQ(tear.steps(), 99) << tear.message();
+  EXPECT_GE(tear.steps(), 90) << tear.message();  // see above
   expect_torn(m, in, tear, "arc");
 }
 
@@ -177,7 +178,7 @@ TEST(Tear, AlongTheArm) {
     const double z = 0.08 + 0.2 * i / 99.0, a = 0.3 + 0.4 * i / 99.0;
     tear.advance({double(i), {0, 0, z}, {0.2 * std::cos(a), 0.2 * std::sin(a), z}});
   }
-  EXPECT_EQ(tear.steps(), 99) << tear.message();
+  EXPECT_GE(tear.steps(), 90) << tear.message();  // see above
   expect_torn(m, in, tear, "arm");
 }
 
@@ -249,6 +250,7 @@ TEST(Tear, PropertyRandomScalpelPaths) {
     if (testing::Test::HasFailure()) break;
   }
   EXPECT_GT(extended, attempted * 8 / 10);
+  RecordProperty("extended", std::to_string(extended) + " of " + std::to_string(attempted));
   RecordProperty("smallest_added_angle_deg_sheet", std::to_string(smallest_sheet * 180 / M_PI));
   RecordProperty("smallest_added_angle_deg_sphere", std::to_string(smallest_sphere * 180 / M_PI));
 }
@@ -302,7 +304,7 @@ TEST(Tear, IndexScanAndNoIndexStartAlike) {
       const double z = 0.08 + 0.12 * i / 59.0, a = 0.3 + 0.4 * i / 59.0;
       tear.advance({double(i + 3), {0, 0, z}, {0.2 * std::cos(a), 0.2 * std::sin(a), z}});
     }
-    EXPECT_EQ(tear.steps(), 59) << mode << ": " << tear.message();
+    EXPECT_GE(tear.steps(), 50) << mode << ": " << tear.message();  // see the straight tear
     expect_torn(m, in, tear, "mode " + std::to_string(mode));
     if (mode == 0) {
       EXPECT_EQ(index.validate(m), "");

@@ -103,14 +103,16 @@ std::pair<double, double> safe_range(const SkinnedMesh& mesh, const Adjacency& a
 // A point inside the polygon `poly` (a face with at most one edge point) for the fan of
 // triangles (poly[i], poly[i + 1], tip): the barycentric `bary` in the face (a, b, c) moved
 // toward the face's incenter, by the first of a few steps that gives every fan triangle its
-// smallest angle ≥ the face's sliver bound (the step with the best fan if none does).
+// smallest angle's sin² ≥ `target` (default: the face's sliver bound), else the step with the
+// best fan; `achieved` gets that fan's quality.
 std::array<double, 3> place_tip(const std::array<double, 3>& bary, const Eigen::Vector3d& a,
                                 const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                                const std::vector<Eigen::Vector3d>& poly, double floor) {
+                                const std::vector<Eigen::Vector3d>& poly, double floor,
+                                double* achieved = nullptr, double target = -1) {
   const double la = (c - b).norm(), lb = (a - c).norm(), lc = (b - a).norm(), p = la + lb + lc;
   if (!(p > 0)) return bary;
   const std::array<double, 3> in{la / p, lb / p, lc / p};
-  const double bound = sliver_bound_sin2(a, b, c, floor);
+  const double bound = target >= 0 ? target : sliver_bound_sin2(a, b, c, floor);
   std::array<double, 3> best = bary;
   double best_q = -1;
   for (const double lambda : {0.0, 0.25, 0.5, 0.75, 1.0}) {
@@ -120,9 +122,10 @@ std::array<double, 3> place_tip(const std::array<double, 3>& bary, const Eigen::
     double q = 1;
     for (std::size_t i = 0; i < poly.size(); ++i)
       q = std::min(q, smallest_angle_sin2(poly[i], poly[(i + 1) % poly.size()], tip));
-    if (q >= bound) return w;
     if (q > best_q) best_q = q, best = w;
+    if (q >= bound) break;
   }
+  if (achieved) *achieved = best_q;
   return best;
 }
 
@@ -480,7 +483,18 @@ TearStep Tear::advance(const ScalpelSample& s) {
           ring.push_back(pos(c.in, c.face));
       }
       target = pos(c.out, c.face);
-      c.out.bary = place_tip(c.out.bary, fa, fb, fc, ring, options_.min_angle);
+      // Aim at the floor itself. A face thinner than that (one the tear made, e.g. in the
+      // old tip's fan after a short step, or a thin input face) whose fan cannot keep the
+      // floor is not split: the step waits for the blade to move on (splitting it anyway
+      // would halve its thin corners step after step).
+      const double floor2 = std::pow(std::sin(options_.min_angle), 2);
+      const double bound = sliver_bound_sin2(fa, fb, fc, options_.min_angle);
+      double achieved = 0;
+      c.out.bary = place_tip(c.out.bary, fa, fb, fc, ring, options_.min_angle, &achieved, floor2);
+      if (achieved < floor2 && bound < floor2) {
+        message_ = "the blade is in a face too thin for a new tip: waiting for it to move on";
+        return step;
+      }
     }
     const std::int32_t in = id_of(c.in, c.face), out = id_of(c.out, c.face);
     points.push_back(out);

@@ -25,16 +25,21 @@
 // returned so a soft body can mirror them. New vertices carry weights, UVs and normals as
 // described in topology_change.hpp.
 //
-// Slivers (see analysis.hpp, sliver_bound_sin2): each split keeps the faces it adds at or
-// above min(min_angle, half the smallest angle of the face it splits), quads along the
-// diagonal with the larger smallest angle. The cut's guarantee relative to the *input* face
-// does not hold yet across steps: a step may split a face an earlier step made, whose own
-// bound is lower. Smallest added angle over the property tests (300 random scalpel paths on a
-// sheet and a sphere): 0.014° before, 0.65° now.
+// No slivers (the cut's guarantee, see analysis.hpp): every face the tear adds has smallest
+// angle ≥ min(min_angle, half the smallest angle of the input face it lies in), min_angle =
+// kTearMinAngle = 5° by default. Each split keeps the faces it makes at or above min(min_angle,
+// half the corner it splits) (quads along the diagonal with the larger smallest angle), and a
+// new tip is only put in a face where its fan can keep min_angle itself, or in an input face at
+// its bound: a sample whose blade lies in a thinner face (typically a face of the old tip's fan
+// after a short step) leaves the mesh unchanged and waits for the blade to move on, so thin
+// corners are never halved step after step. Smallest added angle over the property tests (300
+// random scalpel paths on a sheet and a sphere, 89 % of the samples extending the tear): 5.0°,
+// against 0.014° before (95 % extending).
 //
 // Degenerate input: non-finite samples throw std::invalid_argument; a blade outside the
-// mesh, a blade that has not moved, a blade collinear with the tip, or a walk that reaches a
-// boundary or the step limit leave the mesh unchanged for that sample (see message()).
+// mesh, a blade that has not moved, a blade collinear with the tip, a blade in a face too thin
+// for a new tip, or a walk that reaches a boundary or the step limit leave the mesh unchanged
+// for that sample (see message()).
 #pragma once
 
 #include <Eigen/Core>
