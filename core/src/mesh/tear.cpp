@@ -132,7 +132,10 @@ std::array<double, 3> place_tip(const std::array<double, 3>& bary, const Eigen::
 }  // namespace
 
 Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, const TearOptions& options)
-    : mesh_(mesh), adjacency_(adjacency), options_(options) {
+    : mesh_(mesh),
+      adjacency_(adjacency),
+      options_(options),
+      first_new_vertex_(mesh.vertex_count()) {
   if (!adjacency.matches(mesh))
     throw std::invalid_argument("tear: the adjacency does not describe this mesh");
   if (!(options.snap_fraction > 0 && options.snap_fraction < 0.25) ||
@@ -483,15 +486,16 @@ TearStep Tear::advance(const ScalpelSample& s) {
           ring.push_back(pos(c.in, c.face));
       }
       target = pos(c.out, c.face);
-      // Aim at the floor itself. A face thinner than that (one the tear made, e.g. in the
-      // old tip's fan after a short step, or a thin input face) whose fan cannot keep the
-      // floor is not split: the step waits for the blade to move on (splitting it anyway
-      // would halve its thin corners step after step).
+      // Aim at the floor itself. A face the tear made (it holds a vertex the tear added), e.g.
+      // in the old tip's fan after a short step, whose fan cannot keep the floor is not split:
+      // the step waits for the blade to move on (splitting it anyway would halve its thin
+      // corners step after step). An input face needs only its own bound.
       const double floor2 = std::pow(std::sin(options_.min_angle), 2);
-      const double bound = sliver_bound_sin2(fa, fb, fc, options_.min_angle);
       double achieved = 0;
       c.out.bary = place_tip(c.out.bary, fa, fb, fc, ring, options_.min_angle, &achieved, floor2);
-      if (achieved < floor2 && bound < floor2) {
+      const bool made_by_tear =
+          f[0] >= first_new_vertex_ || f[1] >= first_new_vertex_ || f[2] >= first_new_vertex_;
+      if (achieved < floor2 && made_by_tear) {
         message_ = "the blade is in a face too thin for a new tip: waiting for it to move on";
         return step;
       }

@@ -70,7 +70,7 @@ struct Pieces {
 };
 
 /// Connected components of faces sharing a vertex, numbered in order of their lowest face.
-/// O(V + F).
+/// O(V + F); its working arrays are kept per thread between calls.
 Pieces label_pieces(const SkinnedMesh& mesh);
 
 }  // namespace conform::mesh

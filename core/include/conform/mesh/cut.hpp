@@ -83,7 +83,9 @@ struct CutResult {
 void classify_vertices(const SkinnedMesh& mesh, const cga::Plane<double>& plane,
                        Predicates predicates, std::vector<double>& distance);
 
-/// Computes the change without touching the mesh.
+/// Computes the change without touching the mesh. O(V + F) for the classification, then
+/// proportional to the faces near the plane; the working arrays are kept per thread between
+/// calls (no allocation but for the result).
 CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane,
                       const CutOptions& options = {});
 
