@@ -932,9 +932,9 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     const Eigen::Vector3d &p0 = X[std::size_t(v0)].x, &p1 = X[std::size_t(v1)].x,
                           &p2 = X[std::size_t(v2)].x;
     if (s[lone] > 0) return smallest_angle(p0, x01, x20);
-    return split_02(x01, p1, p2, x20)
-               ? std::min(smallest_angle(x01, p1, p2), smallest_angle(x01, p2, x20))
-               : std::min(smallest_angle(x01, p1, x20), smallest_angle(p1, p2, x20));
+    // The quad (x01, v1, v2, x20), split as split_02 would.
+    return std::max(std::min(smallest_angle(x01, p1, p2), smallest_angle(x01, p2, x20)),
+                    std::min(smallest_angle(x01, p1, x20), smallest_angle(p1, p2, x20)));
   };
   auto bound = [&](const Region::LocalFace& lf) {
     auto& o = region.origins[std::size_t(lf.origin)];
@@ -947,7 +947,7 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
     return o.bound;
   };
   constexpr double kAngleSnap = 0.1;
-  constexpr int kMendRounds = 2;
+  constexpr int kMendRounds = 4;
   auto& unmended = region.work;
   for (int round = 0;; ++round) {
     const bool last = round == kMendRounds;
