@@ -55,7 +55,7 @@ struct Scratch {
   std::vector<Pending> pending;
   std::vector<std::pair<std::int32_t, std::int32_t>> on_plane;
   std::vector<std::array<std::int32_t, 3>> pending_local;
-  std::vector<std::uint8_t> ambiguous, visited;
+  std::vector<std::uint8_t> ambiguous, visited, diagonal;
   std::vector<std::uint64_t> plus_edges;
 };
 Scratch& scratch() {
@@ -219,8 +219,9 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     return df / (df - dt);
   };
   // The split of face f with sides s (crossed): the quality (smallest angle's sin²) of its
-  // worst triangle, and whether a crossing falls within `snap` of an edge's end.
-  auto split_quality = [&](const Face& f, const std::int8_t* s) {
+  // worst triangle, or −1 when a crossing falls within `snap` of an edge's end; for a lone
+  // vertex, `first_diagonal` tells how its quad is split (as step 3 will).
+  auto split_quality = [&](const Face& f, const std::int8_t* s, bool* first_diagonal) {
     int zero = -1;
     for (int k = 0; k < 3; ++k)
       if (s[k] == 0) zero = k;
@@ -240,26 +241,32 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     if (t01 < snap || t01 > 1 - snap || t02 < snap || t02 > 1 - snap) return -1.0;
     const Eigen::Vector3d x01 = crossing_point(v0, v1), x20 = crossing_point(v2, v0);
     const Eigen::Vector3d p0 = point(v0), p1 = point(v1), p2 = point(v2);
-    return std::min(smallest_angle_sin2(p0, x01, x20), best_quad_split(x01, p1, p2, x20).quality);
+    const QuadSplit quad = best_quad_split(x01, p1, p2, x20);
+    if (first_diagonal) *first_diagonal = quad.first_diagonal;
+    return std::min(smallest_angle_sin2(p0, x01, x20), quad.quality);
   };
   const double floor_sin2 = std::sin(options.min_angle) * std::sin(options.min_angle);
   std::vector<std::int32_t>&crossed = sc.crossed, &evaluate = sc.evaluate, &again = sc.again,
   &snapped_now = sc.snapped_now;
   crossed.clear(), evaluate.clear(), again.clear(), snapped_now.clear();
+  std::vector<std::uint8_t>& quad_diagonal = sc.diagonal;  // per crossed face, for step 3
   bool outside_work = false;  // a vertex not flagged near was snapped: its faces are not in work
   for (const std::int32_t fi : work) {
     const Face& f = faces[fi];
     if (sd[f[0]] * sd[f[1]] < 0 || sd[f[1]] * sd[f[2]] < 0 || sd[f[2]] * sd[f[0]] < 0)
       crossed.push_back(fi);
   }
-  evaluate = crossed;
+  quad_diagonal.assign(crossed.size(), 1);
+  for (std::size_t i = 0; i < crossed.size(); ++i) evaluate.push_back(static_cast<std::int32_t>(i));
   while (!evaluate.empty()) {
     snapped_now.clear();
-    for (const std::int32_t fi : evaluate) {
-      const Face& f = faces[fi];
+    for (const std::int32_t ci : evaluate) {
+      const Face& f = faces[crossed[static_cast<std::size_t>(ci)]];
       std::int8_t s[3] = {sd[f[0]], sd[f[1]], sd[f[2]]};
       if (!(s[0] * s[1] < 0 || s[1] * s[2] < 0 || s[2] * s[0] < 0)) continue;
-      const double quality = split_quality(f, s);
+      bool first_diagonal = true;
+      const double quality = split_quality(f, s, &first_diagonal);
+      quad_diagonal[static_cast<std::size_t>(ci)] = first_diagonal;
       if (quality >= floor_sin2) continue;  // the bound is never above the floor
       const double bound =
           sliver_bound_sin2(point(f[0]), point(f[1]), point(f[2]), options.min_angle);
@@ -278,7 +285,7 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
         const std::int8_t keep = s[k];
         s[k] = 0;
         const bool ok = !(s[0] * s[1] < 0 || s[1] * s[2] < 0 || s[2] * s[0] < 0) ||
-                        split_quality(f, s) >= bound;
+                        split_quality(f, s, nullptr) >= bound;
         s[k] = keep;
         return ok;
       };
@@ -301,13 +308,13 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     std::sort(snapped_now.begin(), snapped_now.end());
     again.clear();
     if (!snapped_now.empty())
-      for (const std::int32_t fi : crossed) {
-        const Face& f = faces[fi];
+      for (std::size_t ci = 0; ci < crossed.size(); ++ci) {
+        const Face& f = faces[crossed[ci]];
         bool touched = false;
         for (auto v : f) touched |= std::binary_search(snapped_now.begin(), snapped_now.end(), v);
         if (touched &&
             (sd[f[0]] * sd[f[1]] < 0 || sd[f[1]] * sd[f[2]] < 0 || sd[f[2]] * sd[f[0]] < 0))
-          again.push_back(fi);
+          again.push_back(static_cast<std::int32_t>(ci));
       }
     evaluate.swap(again);
   }
@@ -360,6 +367,7 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
   std::vector<std::int32_t> split;
   split.reserve(work.size());
   const Eigen::Vector3d n = plane.normal();
+  std::size_t next_crossed = 0;  // walks `crossed` along with `work` (both increasing)
   for (const std::int32_t fi : work) {
     const Face& f = faces[fi];
     const std::int8_t s[3] = {side[static_cast<std::size_t>(f[0])],
@@ -405,7 +413,9 @@ CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane_i
     const std::int8_t s0 = s[lone];
     const auto s1 = static_cast<std::int8_t>(-s0);
     pending.push_back({{v0, x01, x20}, {v0, x01, x20}, s0, -1});
-    if (best_quad_split(pos(x01), pos(v1), pos(v2), pos(x20)).first_diagonal) {
+    // The diagonal step 2 chose for this face (its last evaluation saw these sides).
+    while (sc.crossed[next_crossed] != fi) ++next_crossed;
+    if (quad_diagonal[next_crossed]) {
       pending.push_back({{x01, v1, v2}, {x01, v1, v2}, s1, -1});
       pending.push_back({{x01, v2, x20}, {x01, v2, x20}, s1, -1});
     } else {
