@@ -56,7 +56,10 @@ void EdgeMap::erase(std::int32_t u, std::int32_t v, std::int32_t value) {
 void Adjacency::build(const SkinnedMesh& mesh) {
   const std::int32_t nf = mesh.face_count();
   map_.clear();
-  map_.reserve(3 * static_cast<std::size_t>(nf));
+  // Room for about 1/8 more half-edges (as ColumnArray leaves for vertices), so that the first
+  // edits after a build do not rehash the whole table.
+  const std::size_t half_edges = 3 * static_cast<std::size_t>(nf);
+  map_.reserve(half_edges + half_edges / 8 + 64);
   twin_.assign(3 * static_cast<std::size_t>(nf), -1);
   nonmanifold_ = 0;
   for (std::int32_t f = 0; f < nf; ++f) {
