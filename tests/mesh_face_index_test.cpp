@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
+#include <iterator>
 #include <random>
 
 #include "conform/cga/plane.hpp"
@@ -248,4 +250,138 @@ TEST(FaceIndex, SlotBookkeepingOfRandomChanges) {
     ASSERT_EQ(index.validate(m), "") << round;
   }
   expect_same_as_scan(index, m, random_segments(m, 1000, rng), "after random removals");
+}
+
+namespace {
+
+// The longest root-to-leaf path a batch of `added` faces may add: the path down to the leaf
+// that takes them, one level for the new parent, and a built subtree (log2(added / 4) + 1
+// levels, +1 for rounding); one-by-one insertions near their hints split leaves (a few levels).
+int depth_bound(int before, std::size_t added) {
+  return before + static_cast<int>(std::ceil(std::log2(std::max<double>(added, 4) / 4.0))) + 4;
+}
+
+// The vertex of `m` nearest to direction `d`.
+std::int32_t nearest_vertex(const SkinnedMesh& m, const Eigen::Vector3d& d) {
+  Eigen::Index best = 0;
+  (m.current.colwise() - d).colwise().squaredNorm().minCoeff(&best);
+  return static_cast<std::int32_t>(best);
+}
+
+}  // namespace
+
+TEST(FaceIndex, LargeBatchInsideAClosedMeshStaysExact) {
+  // A rings-like tube wall of new vertices inside a sphere (radius 0.4, far from every surface
+  // leaf), added in ONE change together with surface faces put back in their slots: the index
+  // stays sound, exact, and not much deeper.
+  std::mt19937 rng(16);
+  SkinnedMesh m = make_icosphere(4);
+  FaceIndex index(m);
+  const int depth_before = index.depth();
+  TopologyChange ch;
+  ch.base_vertex_count = m.vertex_count();
+  ch.base_face_count = m.face_count();
+  for (std::int32_t f = 0; f < m.face_count(); f += 97) ch.removed_faces.push_back(f);
+  for (auto f : ch.removed_faces) ch.added_faces.push_back(m.faces[static_cast<std::size_t>(f)]);
+  constexpr int kAround = 24, kRings = 12;
+  for (int j = 0; j < kRings; ++j)
+    for (int i = 0; i < kAround; ++i) {
+      const double z = -0.6 + 1.2 * j / (kRings - 1), a = 2 * M_PI * i / kAround,
+                   rho = std::sqrt(1 - z * z);
+      const Eigen::Vector3d d(rho * std::cos(a), rho * std::sin(a), z);
+      ch.new_vertices.push_back(
+          NewVertex::on_edge(nearest_vertex(m, d), nearest_vertex(m, -d), 0.3));
+    }
+  auto vid = [&](int j, int i) { return ch.base_vertex_count + j * kAround + (i % kAround); };
+  for (int j = 0; j + 1 < kRings; ++j)
+    for (int i = 0; i < kAround; ++i) {
+      ch.added_faces.push_back({vid(j, i), vid(j, i + 1), vid(j + 1, i + 1)});
+      ch.added_faces.push_back({vid(j, i), vid(j + 1, i + 1), vid(j + 1, i)});
+    }
+  apply(m, ch);
+  index.update(m, ch);
+  ASSERT_EQ(index.validate(m), "");
+  EXPECT_LE(index.depth(), depth_bound(depth_before, ch.added_faces.size()))
+      << "before " << depth_before;
+  // Segments across the sphere, through the tube, and along its axis.
+  auto segments = random_segments(m, 3000, rng);
+  for (int i = 0; i < 200; ++i) {
+    const double z = -0.7 + 1.4 * i / 199.0;
+    segments.emplace_back(Eigen::Vector3d(-1.2, 0.01 * i, z), Eigen::Vector3d(1.2, -0.01 * i, z));
+  }
+  EXPECT_GT(expect_same_as_scan(index, m, segments, "tube in a sphere"), 1000);
+  // The same change without the faces put back: no hints at all (pure addition).
+  SkinnedMesh m2 = make_icosphere(4);
+  FaceIndex index2(m2);
+  TopologyChange add = ch;
+  add.removed_faces.clear();
+  add.added_faces.erase(
+      add.added_faces.begin(),
+      add.added_faces.begin() + static_cast<std::ptrdiff_t>(ch.removed_faces.size()));
+  apply(m2, add);
+  index2.update(m2, add);
+  ASSERT_EQ(index2.validate(m2), "");
+  EXPECT_LE(index2.depth(), depth_bound(depth_before, add.added_faces.size()));
+  EXPECT_GT(expect_same_as_scan(index2, m2, segments, "tube added alone"), 1000);
+}
+
+TEST(FaceIndex, RandomLargeBatchesStayExact) {
+  // Rounds of changes that remove random faces and add many random ones (triangles between
+  // random vertices, crossing the sphere's inside), some small, most large: the index follows
+  // exactly, and each round deepens it by no more than a built subtree would.
+  std::mt19937 rng(17);
+  SkinnedMesh m = make_icosphere(3);
+  FaceIndex index(m);
+  const std::size_t sizes[] = {3000, 17, 5, 400, 1200, 16, 64};
+  for (std::size_t round = 0; round < std::size(sizes); ++round) {
+    const int depth_before = index.depth();
+    TopologyChange ch;
+    ch.base_vertex_count = m.vertex_count();
+    ch.base_face_count = m.face_count();
+    std::uniform_int_distribution<std::int32_t> any_face(0, m.face_count() - 1);
+    std::uniform_int_distribution<std::int32_t> any_vertex(0, m.vertex_count() - 1);
+    for (int i = 0; i < 30; ++i) ch.removed_faces.push_back(any_face(rng));
+    std::sort(ch.removed_faces.begin(), ch.removed_faces.end());
+    ch.removed_faces.erase(std::unique(ch.removed_faces.begin(), ch.removed_faces.end()),
+                           ch.removed_faces.end());
+    while (ch.added_faces.size() < sizes[round]) {
+      const Face t{any_vertex(rng), any_vertex(rng), any_vertex(rng)};
+      if (t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) ch.added_faces.push_back(t);
+    }
+    apply(m, ch);
+    index.update(m, ch);
+    ASSERT_EQ(index.validate(m), "") << round;
+    EXPECT_LE(index.depth(), depth_bound(depth_before, ch.added_faces.size())) << round;
+    expect_same_as_scan(index, m, random_segments(m, 600, rng), "round " + std::to_string(round));
+  }
+}
+
+TEST(FaceIndex, DrillWithTubeRingsKeepsTheIndexExact) {
+  // The drill's one change with tube walls and rings (~1,300 faces inside the limb at the
+  // paper's size): sound, exact, and the tree only a subtree's depth deeper.
+  std::mt19937 rng(18);
+  SkinnedMesh m = make_arm(1).mesh;
+  Adjacency adj(m);
+  FaceIndex index(m);
+  const int depth_before = index.depth();
+  const std::int32_t faces_before = m.face_count();
+  DrillOptions o;
+  o.tube = true;
+  o.tube_ring_spacing = 2;
+  const DrillResult d = drill(m, adj, index, {{0, -0.2, 0.42}, {0, 0.2, 0.42}, 0.01}, o);
+  ASSERT_EQ(d.tubes, 1) << d.message;
+  ASSERT_EQ(index.validate(m), "");
+  const auto added = static_cast<std::size_t>(m.face_count() - faces_before);
+  EXPECT_GT(added, 500u);
+  EXPECT_LE(index.depth(), depth_bound(depth_before, added)) << "before " << depth_before;
+  std::cout << "depth " << depth_before << " -> " << index.depth() << " (" << faces_before << " -> "
+            << m.face_count() << " faces)\n";
+  auto segments = random_segments(m, 2000, rng);
+  for (int i = 0; i < 200; ++i) {  // along and across the drill's axis
+    const double s = 0.004 * (i % 10) - 0.02, z = 0.42 + 0.0002 * (i / 10);
+    segments.emplace_back(Eigen::Vector3d(s, -0.3, z), Eigen::Vector3d(-s, 0.3, z + 0.001 * s));
+    segments.emplace_back(Eigen::Vector3d(-0.02, 0.01 * (i % 40) - 0.2, z),
+                          Eigen::Vector3d(0.02, 0.01 * (i % 40) - 0.2, z));
+  }
+  EXPECT_GT(expect_same_as_scan(index, m, segments, "rings drill"), 500);
 }

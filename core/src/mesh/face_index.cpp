@@ -185,16 +185,28 @@ void FaceIndex::build(const SkinnedMesh& mesh) {
   leaf_of_.assign(static_cast<std::size_t>(nf), -1);
   fitted_ = true;
   if (nf == 0) return;
+  std::vector<std::int32_t> faces(static_cast<std::size_t>(nf));
+  std::iota(faces.begin(), faces.end(), 0);
+  nodes_.push_back({});
+  build_subtree(mesh, faces, 0);
+  reserve(nf / 8 + 1024);
+  refit(mesh);
+}
+
+void FaceIndex::build_subtree(const SkinnedMesh& mesh, const std::vector<std::int32_t>& faces,
+                              std::int32_t root) {
   // Faces in Morton order of their centroids (21 bits per axis over the centroids' box), then
   // a balanced tree over that order by halving: spatially coherent leaves at the cost of a sort.
-  std::vector<Eigen::Vector3d> centroid(static_cast<std::size_t>(nf));
+  // New nodes are appended (after `root`, which exists); boxes are left to the caller.
+  const auto nf = static_cast<std::int32_t>(faces.size());
+  std::vector<Eigen::Vector3d> centroid(faces.size());
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;
-  for (std::int32_t f = 0; f < nf; ++f) {
-    const Face& t = mesh.faces[static_cast<std::size_t>(f)];
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const Face& t = mesh.faces[static_cast<std::size_t>(faces[i])];
     const Eigen::Vector3d c =
         (mesh.current.col(t[0]) + mesh.current.col(t[1]) + mesh.current.col(t[2])) / 3;
-    centroid[static_cast<std::size_t>(f)] = c;
+    centroid[i] = c;
     lo = lo.cwiseMin(c);
     hi = hi.cwiseMax(c);
   }
@@ -209,25 +221,24 @@ void FaceIndex::build(const SkinnedMesh& mesh) {
     x = (x | x << 2) & 0x1249249249249249ull;
     return x;
   };
-  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(static_cast<std::size_t>(nf));
-  for (std::int32_t f = 0; f < nf; ++f) {
-    const Eigen::Vector3d q = (centroid[static_cast<std::size_t>(f)] - lo) * scale;
+  std::vector<std::pair<std::uint64_t, std::int32_t>> keyed(faces.size());
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const Eigen::Vector3d q = (centroid[i] - lo) * scale;
     std::uint64_t code = 0;
     for (int k = 0; k < 3; ++k) {
       const double x = std::isfinite(q[k]) ? std::clamp(q[k], 0.0, double(1 << 21) - 1) : 0;
       code |= spread(static_cast<std::uint64_t>(x)) << k;
     }
-    keyed[static_cast<std::size_t>(f)] = {code, f};
+    keyed[i] = {code, faces[i]};
   }
   std::sort(keyed.begin(), keyed.end());
-  const std::size_t leaves = static_cast<std::size_t>(nf) / kLeafBuild + 1;
-  nodes_.reserve(2 * leaves + 16);
-  items_.reserve(kLeafCapacity * leaves + 64);
+  const std::size_t leaves = faces.size() / kLeafBuild + 1;
+  nodes_.reserve(nodes_.size() + 2 * leaves + 16);
+  items_.reserve(items_.size() + kLeafCapacity * leaves + 64);
   struct Task {
     std::int32_t node, begin, end;
   };
-  std::vector<Task> stack{{0, 0, nf}};
-  nodes_.push_back({});
+  std::vector<Task> stack{{root, 0, nf}};
   while (!stack.empty()) {
     const Task task = stack.back();
     stack.pop_back();
@@ -235,6 +246,7 @@ void FaceIndex::build(const SkinnedMesh& mesh) {
     if (n <= kLeafBuild) {
       const std::int32_t first = new_leaf_block();
       Node& leaf = nodes_[static_cast<std::size_t>(task.node)];
+      leaf.child = -1;
       leaf.first = first;
       leaf.count = n;
       for (std::int32_t i = 0; i < n; ++i) {
@@ -246,7 +258,10 @@ void FaceIndex::build(const SkinnedMesh& mesh) {
     }
     const std::int32_t mid = task.begin + n / 2;
     const auto child = static_cast<std::int32_t>(nodes_.size());
-    nodes_[static_cast<std::size_t>(task.node)].child = child;
+    Node& node = nodes_[static_cast<std::size_t>(task.node)];
+    node.child = child;
+    node.first = -1;
+    node.count = 0;
     Node c;
     c.parent = task.node;
     nodes_.push_back(c);
@@ -254,8 +269,6 @@ void FaceIndex::build(const SkinnedMesh& mesh) {
     stack.push_back({child + 1, mid, task.end});
     stack.push_back({child, task.begin, mid});
   }
-  reserve(nf / 8 + 1024);
-  refit(mesh);
 }
 
 void FaceIndex::reserve(std::int32_t more) {
@@ -460,10 +473,111 @@ void FaceIndex::update(const SkinnedMesh& mesh, const TopologyChange& change) {
   // The operations list added faces in the order of the faces they replace, so the k-th added
   // face most likely lies where removed face k·R/A lay: it enters the tree from that face's
   // leaf (and stays there when the leaf's box holds it).
-  for (std::size_t k = 0; k < na; ++k) {
-    const std::int32_t near = nr == 0 ? 0 : old_leaf[k * nr / na];
-    add(mesh, slot_of[k], near);
+  if (batch_) {
+    for (std::size_t k = 0; k < na; ++k) add(mesh, slot_of[k], nr == 0 ? 0 : old_leaf[k * nr / na]);
+    return;
   }
+  std::vector<std::int32_t> hint(na);
+  for (std::size_t k = 0; k < na; ++k) hint[k] = nr == 0 ? -1 : old_leaf[k * nr / na];
+  insert_many(mesh, slot_of, hint);
+}
+
+void FaceIndex::insert_many(const SkinnedMesh& mesh, const std::vector<std::int32_t>& faces,
+                            const std::vector<std::int32_t>& hint) {
+  // Few faces: one by one from their hints. Many (a drill's tube walls and rings, a large
+  // refinement): a face whose box lies within its hint's leaf or two levels above it is local
+  // and enters one by one as well (a short climb and descent); the others (no hint, or faces
+  // away from the leaf they replace, e.g. inside the limb) would each climb near the root and
+  // descend its whole depth: they are built into one subtree instead (as build() does), hung
+  // where its box grows the tree least.
+  if (faces.size() <= kBulkMin || nodes_.empty()) {
+    if (faces.size() > kBulkMin) return insert_subtree(mesh, faces);
+    for (std::size_t k = 0; k < faces.size(); ++k)
+      insert(mesh, faces[k], face_box(mesh, faces[k]), std::max(hint[k], 0));
+    return;
+  }
+  std::vector<std::int32_t> rest;
+  Box rest_box;
+  for (int k = 0; k < 3; ++k) rest_box.lo[k] = kInf, rest_box.hi[k] = -kInf;
+  for (std::size_t k = 0; k < faces.size(); ++k) {
+    const Box fb = face_box(mesh, faces[k]);
+    bool local = false;
+    std::int32_t n = hint[k];
+    for (int up = 0; up < 3 && n >= 0 && !local;
+         ++up, n = nodes_[static_cast<std::size_t>(n)].parent)
+      local = contains(nodes_[static_cast<std::size_t>(n)].box, fb);
+    if (local)
+      insert(mesh, faces[k], fb, hint[k]);
+    else
+      rest.push_back(faces[k]), grow(rest_box, fb);
+  }
+  if (rest.size() > kBulkMin) return insert_subtree(mesh, rest, &rest_box);
+  for (auto f : rest) insert(mesh, f, face_box(mesh, f), 0);
+}
+
+void FaceIndex::insert_subtree(const SkinnedMesh& mesh, const std::vector<std::int32_t>& faces,
+                               const Box* box) {
+  const auto first_new = static_cast<std::int32_t>(nodes_.size());
+  std::int32_t root = 0, slot = 0;  // the new subtree's root; the slot that takes it
+  if (nodes_.empty()) {
+    nodes_.push_back({});
+  } else {
+    // The batch's box, then down from the root where it grows the boxes least (as insert()),
+    // to a leaf L. Only a leaf can take a sibling in place (an internal node's children must
+    // stay after it): L's slot becomes the parent of L (moved to the end) and the new subtree.
+    Box bb;
+    if (box) {
+      bb = *box;
+    } else {
+      for (int k = 0; k < 3; ++k) bb.lo[k] = kInf, bb.hi[k] = -kInf;
+      for (auto f : faces) grow(bb, face_box(mesh, f));
+    }
+    std::int32_t n = 0;
+    while (nodes_[static_cast<std::size_t>(n)].child >= 0) {
+      const Node& node = nodes_[static_cast<std::size_t>(n)];
+      double best_cost = 0, best_area = 0;
+      std::int32_t best = -1;
+      for (std::int32_t c = node.child; c < node.child + 2; ++c) {
+        Box u = nodes_[static_cast<std::size_t>(c)].box;
+        const double before = area(u);
+        grow(u, bb);
+        const double after = area(u), cost = after - before;
+        if (best < 0 || cost < best_cost || (cost == best_cost && after < best_area))
+          best = c, best_cost = cost, best_area = after;
+      }
+      n = best;
+    }
+    root = slot = n;
+    if (nodes_[static_cast<std::size_t>(n)].count > 0) {
+      Node moved = nodes_[static_cast<std::size_t>(n)];
+      moved.parent = n;
+      for (std::int32_t i = 0; i < moved.count; ++i)
+        leaf_of_[static_cast<std::size_t>(items_[static_cast<std::size_t>(moved.first + i)])] =
+            first_new;
+      Node fresh;
+      fresh.parent = n;
+      nodes_.push_back(moved);
+      nodes_.push_back(fresh);
+      Node& at = nodes_[static_cast<std::size_t>(n)];
+      at.child = first_new;
+      at.first = -1;
+      at.count = 0;
+      root = first_new + 1;
+    }
+  }
+  build_subtree(mesh, faces, root);
+  // Fit the new nodes (children after parents), then the slot that took them, then upwards.
+  for (auto i = static_cast<std::int32_t>(nodes_.size()); i-- > first_new;) fit_node(mesh, i);
+  if (slot < first_new) fit_node(mesh, slot);
+  const std::int32_t up = nodes_[static_cast<std::size_t>(slot)].parent;
+  if (up >= 0) grow_up(up, nodes_[static_cast<std::size_t>(slot)].box);
+}
+
+void FaceIndex::fit_node(const SkinnedMesh& mesh, std::int32_t i) {
+  Node& n = nodes_[static_cast<std::size_t>(i)];
+  if (n.child < 0) return fit_leaf(mesh, i);
+  n.box = nodes_[static_cast<std::size_t>(n.child)].box;
+  grow(n.box, nodes_[static_cast<std::size_t>(n.child + 1)].box);
 }
 
 std::int32_t FaceIndex::hint_of(std::int32_t f) const {
@@ -481,14 +595,16 @@ void FaceIndex::add(const SkinnedMesh& mesh, std::int32_t f, std::int32_t near) 
 
 void FaceIndex::end_batch(const SkinnedMesh& mesh) {
   batch_ = false;
+  std::vector<std::int32_t> faces, hint;
   for (auto f : pending_) {
     if (f >= face_count() || leaf_of_[static_cast<std::size_t>(f)] != kPending) continue;
-    const std::int32_t near = hint_of(f);
+    faces.push_back(f);
+    hint.push_back(hint_of(f));
     leaf_of_[static_cast<std::size_t>(f)] = -1;
-    insert(mesh, f, face_box(mesh, f), near);
   }
   pending_.clear();
   pending_hint_.clear();
+  insert_many(mesh, faces, hint);
 }
 
 int FaceIndex::depth() const {

@@ -20,7 +20,11 @@
 //   - after every TopologyChange applied to the mesh: update(mesh, change), with the mesh
 //     already changed (O(changed faces · depth)). Tear and drill given an index do this
 //     themselves for every change they apply; a cut (or any other change) applied by the
-//     caller must be followed by update() as well;
+//     caller must be followed by update() as well. Added faces near the faces they replace
+//     enter one by one; when more than 16 others come in one change (the drill's tube walls
+//     and rings, inside the limb and away from every surface leaf), they are built into one
+//     subtree (as build() does) hung at the leaf where their box grows the tree least, rather
+//     than each descending the whole tree (faster, and the tree stays far shallower);
 //   - boxes only grow under update(): after many changes, refit() tightens them and build()
 //     restores a balanced tree.
 // Queries use the faces' exact positions at query time for the final test, and the boxes to
@@ -83,8 +87,9 @@ class FaceIndex {
   /// change was not computed for the mesh this index describes.
   void update(const SkinnedMesh& mesh, const TopologyChange& change);
   /// Between begin_batch() and end_batch(mesh), update() defers its insertions: an operation
-  /// that applies several changes in a row (the drill's hole, then its tube walls) inserts
-  /// only the faces that survive them all. No queries (and no validate) inside a batch.
+  /// that applies several changes in a row (the two phases of a tear step) inserts only the faces
+  /// that survive them all, as one update() would. No queries (and no validate) inside a batch.
+  /// (The drill applies one change and needs no batch.)
   void begin_batch() { batch_ = true; }
   void end_batch(const SkinnedMesh& mesh);
 
@@ -119,6 +124,7 @@ class FaceIndex {
 
  private:
   static constexpr int kLeafBuild = 4, kLeafCapacity = 8;
+  static constexpr std::size_t kBulkMin = 16;  // more faces without a local hint: one subtree
   struct Box {
     float lo[3], hi[3];
   };
@@ -138,6 +144,13 @@ class FaceIndex {
   void split_leaf(const SkinnedMesh& mesh, std::int32_t n, std::int32_t extra);
   void grow_up(std::int32_t n, const Box& box);
   void add(const SkinnedMesh& mesh, std::int32_t f, std::int32_t near);  // insert, or defer
+  void insert_many(const SkinnedMesh& mesh, const std::vector<std::int32_t>& faces,
+                   const std::vector<std::int32_t>& hint);
+  void insert_subtree(const SkinnedMesh& mesh, const std::vector<std::int32_t>& faces,
+                      const Box* box = nullptr);  // box: the faces' boxes' union, if known
+  void build_subtree(const SkinnedMesh& mesh, const std::vector<std::int32_t>& faces,
+                     std::int32_t root);
+  void fit_node(const SkinnedMesh& mesh, std::int32_t n);
   std::int32_t hint_of(std::int32_t f) const;
 
   static constexpr std::int32_t kPending = -2;  // leaf_of_ of a deferred face
