@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <iostream>
 #include <iterator>
 #include <random>
 
@@ -374,8 +373,9 @@ TEST(FaceIndex, DrillWithTubeRingsKeepsTheIndexExact) {
   const auto added = static_cast<std::size_t>(m.face_count() - faces_before);
   EXPECT_GT(added, 500u);
   EXPECT_LE(index.depth(), depth_bound(depth_before, added)) << "before " << depth_before;
-  std::cout << "depth " << depth_before << " -> " << index.depth() << " (" << faces_before << " -> "
-            << m.face_count() << " faces)\n";
+  RecordProperty("depth", std::to_string(depth_before) + " -> " + std::to_string(index.depth()) +
+                              " (" + std::to_string(faces_before) + " -> " +
+                              std::to_string(m.face_count()) + " faces)");
   auto segments = random_segments(m, 2000, rng);
   for (int i = 0; i < 200; ++i) {  // along and across the drill's axis
     const double s = 0.004 * (i % 10) - 0.02, z = 0.42 + 0.0002 * (i / 10);
