@@ -54,7 +54,7 @@ struct AngleCheck {
 };
 void check_angles(const SkinnedMesh& before, const SkinnedMesh& after, const TopologyChange& ch,
                   std::int32_t tube_faces, AngleCheck& out) {
-  const double floor = DrillOptions{}.min_angle_degrees * std::numbers::pi / 180;
+  const double floor = DrillOptions{}.min_angle;
   std::map<std::array<std::int32_t, 3>, std::int32_t> original;  // sorted corners → face
   for (auto f : ch.removed_faces) {
     std::array<std::int32_t, 3> t = before.faces[static_cast<std::size_t>(f)];

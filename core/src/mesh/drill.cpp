@@ -893,7 +893,7 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
       }
   };
   // No slivers: every face the drill adds keeps its smallest angle at least
-  // min(min_angle_degrees, half the smallest angle of the original face it lies in). Rivara's
+  // min(min_angle, half the smallest angle of the original face it lies in). Rivara's
   // bisection keeps half; a face the rim clips is cut into pieces (below) whose angles depend
   // on where the rim crosses its edges: while a piece would be sharper than the bound, one more
   // vertex of that face is taken as a rim vertex (snapped): the nearest to its crossing point
@@ -903,7 +903,7 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
   // they end. A face that no such snap mends is bisected (Rivara) and the classification
   // starts again (at most kMendRounds times); in the last round the nearest vertex that
   // mends the face is snapped however far (else the nearest), so that the bound holds.
-  const double angle_floor = std::max(options.min_angle_degrees, 0.0) * std::numbers::pi / 180;
+  const double angle_floor = std::max(options.min_angle, 0.0);
   auto crossing_x = [&](std::int32_t u, std::int32_t w) -> Eigen::Vector3d {
     const std::int32_t a = std::min(u, w), b = std::max(u, w);
     const double t = crossing_t(a, b);

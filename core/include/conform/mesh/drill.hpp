@@ -28,7 +28,7 @@
 // angle mending below, four times at most, within max_refinements), so that snapped vertices do
 // not lengthen the rim polygon's chords either.
 // Angle guarantee (no slivers): every face the drill adds to the surface has its smallest
-// angle at least min(min_angle_degrees, half the smallest angle of the original face it lies
+// angle at least min(min_angle, half the smallest angle of the original face it lies
 // in) (the tube walls are exempt, see below). Refinement keeps half (Rivara). Where a piece of a
 // clipped face would be sharper, one more vertex of that face is snapped: the nearest to its
 // crossing point among those whose snap mends the face and whose crossing point lies within
@@ -94,12 +94,16 @@ struct DrillTool {
   double radius = 0;
 };
 
+/// The drill's default sliver floor θ_floor (radians): 2° (see above; the cut's and the
+/// tear's are 5°, kCutMinAngle and kTearMinAngle).
+inline constexpr double kDrillMinAngle = 2.0 * 3.14159265358979323846 / 180;
+
 struct DrillOptions {
   int min_rim_points = 24;  // the paper uses 6; 24 keeps the hole's area within 2 % of πr²
   int max_refinements = 6;  // at most 2 × this many bisections of an original face
   double snap_fraction = 0.01;
-  double min_angle_degrees = 2.0;  // the angle guarantee's floor (see above); 0: no guarantee
-  bool tube = false;               // join entry and exit holes of a closed surface with a tube wall
+  double min_angle = kDrillMinAngle;  // sliver floor θ_floor, radians (see above); 0: none
+  bool tube = false;  // join entry and exit holes of a closed surface with a tube wall
   // With the tube: intermediate rings at most this many times the rims' mean edge length
   // apart (0: none, one triangle spans the wall). Ring vertices are new vertices on the
   // segments between the two rims (NewVertex::on_edge of rim vertices).
