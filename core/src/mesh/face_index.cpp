@@ -12,6 +12,15 @@ namespace conform::mesh {
 
 namespace {
 
+// Room for `more` elements beyond the size, growing geometrically (×1.5): a reserve() of just
+// size + more on every change would reallocate and copy the whole array each time (O(F) per
+// change, and fresh pages to fault in).
+template <class T>
+void reserve_more(std::vector<T>& v, std::size_t more) {
+  const std::size_t need = v.size() + more;
+  if (need > v.capacity()) v.reserve(std::max(need, v.capacity() + v.capacity() / 2));
+}
+
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 bool less_hit(const SegmentHit& a, const SegmentHit& b) {
@@ -233,8 +242,8 @@ void FaceIndex::build_subtree(const SkinnedMesh& mesh, const std::vector<std::in
   }
   std::sort(keyed.begin(), keyed.end());
   const std::size_t leaves = faces.size() / kLeafBuild + 1;
-  nodes_.reserve(nodes_.size() + 2 * leaves + 16);
-  items_.reserve(items_.size() + kLeafCapacity * leaves + 64);
+  reserve_more(nodes_, 2 * leaves + 16);
+  reserve_more(items_, kLeafCapacity * leaves + 64);
   struct Task {
     std::int32_t node, begin, end;
   };
@@ -274,9 +283,9 @@ void FaceIndex::build_subtree(const SkinnedMesh& mesh, const std::vector<std::in
 void FaceIndex::reserve(std::int32_t more) {
   // Each leaf split (about one per four inserted faces) adds two nodes and one leaf block.
   const auto m = static_cast<std::size_t>(std::max(more, 0));
-  nodes_.reserve(nodes_.size() + m / 2 + 16);
-  items_.reserve(items_.size() + kLeafCapacity * (m / 4 + 16));
-  leaf_of_.reserve(leaf_of_.size() + m);
+  reserve_more(nodes_, m / 2 + 16);
+  reserve_more(items_, kLeafCapacity * (m / 4 + 16));
+  reserve_more(leaf_of_, m);
 }
 
 void FaceIndex::refit(const SkinnedMesh& mesh) {
