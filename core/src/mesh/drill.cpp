@@ -1004,8 +1004,11 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
           if (c.distance2 < std::numeric_limits<double>::infinity()) candidates[count++] = c;
         }
         if (count == 0) continue;
-        std::sort(candidates.begin(), candidates.begin() + count,
-                  [](const Candidate& x, const Candidate& y) { return x.distance2 < y.distance2; });
+        // At most three: an insertion sort (stable, as std::sort is on so few; its inlined
+        // threshold of 16 draws a false -Warray-bounds from GCC 12 under the sanitizers).
+        for (int i = 1; i < count; ++i)
+          for (int j = i; j > 0 && candidates[j].distance2 < candidates[j - 1].distance2; --j)
+            std::swap(candidates[j], candidates[j - 1]);
         std::int32_t pick = last ? candidates[0].v : -1;
         for (int c = 0; c < count; ++c) {
           if (!last && candidates[c].fraction > kAngleSnap) continue;
