@@ -311,6 +311,22 @@ void FaceIndex::grow_up(std::int32_t n, const Box& box) {
   }
 }
 
+std::int32_t FaceIndex::cheapest_child(std::int32_t n, const Box& box) const {
+  // The child whose box grows least (surface area) to hold `box`, ties to the smaller box.
+  const std::int32_t first = nodes_[static_cast<std::size_t>(n)].child;
+  double best_cost = 0, best_area = 0;
+  std::int32_t best = -1;
+  for (std::int32_t c = first; c < first + 2; ++c) {
+    Box u = nodes_[static_cast<std::size_t>(c)].box;
+    const double before = area(u);
+    grow(u, box);
+    const double after = area(u), cost = after - before;
+    if (best < 0 || cost < best_cost || (cost == best_cost && after < best_area))
+      best = c, best_cost = cost, best_area = after;
+  }
+  return best;
+}
+
 void FaceIndex::insert(const SkinnedMesh& mesh, std::int32_t f, const Box& fb, std::int32_t near) {
   if (nodes_.empty()) {
     Node root;
@@ -328,18 +344,7 @@ void FaceIndex::insert(const SkinnedMesh& mesh, std::int32_t f, const Box& fb, s
     Node& node = nodes_[static_cast<std::size_t>(n)];
     grow(node.box, fb);
     if (node.child < 0) break;
-    // Descend where the box grows least (surface area), ties to the smaller box.
-    double best_cost = 0, best_area = 0;
-    std::int32_t best = -1;
-    for (std::int32_t c = node.child; c < node.child + 2; ++c) {
-      Box u = nodes_[static_cast<std::size_t>(c)].box;
-      const double before = area(u);
-      grow(u, fb);
-      const double after = area(u), cost = after - before;
-      if (best < 0 || cost < best_cost || (cost == best_cost && after < best_area))
-        best = c, best_cost = cost, best_area = after;
-    }
-    n = best;
+    n = cheapest_child(n, fb);
   }
   Node& leaf = nodes_[static_cast<std::size_t>(n)];
   if (leaf.count < kLeafCapacity) {
@@ -542,20 +547,7 @@ void FaceIndex::insert_subtree(const SkinnedMesh& mesh, const std::vector<std::i
       for (auto f : faces) grow(bb, face_box(mesh, f));
     }
     std::int32_t n = 0;
-    while (nodes_[static_cast<std::size_t>(n)].child >= 0) {
-      const Node& node = nodes_[static_cast<std::size_t>(n)];
-      double best_cost = 0, best_area = 0;
-      std::int32_t best = -1;
-      for (std::int32_t c = node.child; c < node.child + 2; ++c) {
-        Box u = nodes_[static_cast<std::size_t>(c)].box;
-        const double before = area(u);
-        grow(u, bb);
-        const double after = area(u), cost = after - before;
-        if (best < 0 || cost < best_cost || (cost == best_cost && after < best_area))
-          best = c, best_cost = cost, best_area = after;
-      }
-      n = best;
-    }
+    while (nodes_[static_cast<std::size_t>(n)].child >= 0) n = cheapest_child(n, bb);
     root = slot = n;
     if (nodes_[static_cast<std::size_t>(n)].count > 0) {
       Node moved = nodes_[static_cast<std::size_t>(n)];

@@ -143,6 +143,7 @@ class FaceIndex {
   void rename(std::int32_t from, std::int32_t to);
   void split_leaf(const SkinnedMesh& mesh, std::int32_t n, std::int32_t extra);
   void grow_up(std::int32_t n, const Box& box);
+  std::int32_t cheapest_child(std::int32_t n, const Box& box) const;     // internal node n
   void add(const SkinnedMesh& mesh, std::int32_t f, std::int32_t near);  // insert, or defer
   void insert_many(const SkinnedMesh& mesh, const std::vector<std::int32_t>& faces,
                    const std::vector<std::int32_t>& hint);
