@@ -1,0 +1,124 @@
+// The constant-strain triangle of a pre-stressed St Venant-Kirchhoff membrane: energy,
+// nodal gradient and the action of a positive semi-definite Hessian approximation.
+//
+// Rest triangle in its own 2D frame: Dm = [X1 - X0, X2 - X0] (2 x 2), B = Dm^-1, area A.
+// Shape-function gradients beta_1 = B.row(0), beta_2 = B.row(1), beta_0 = -beta_1 - beta_2.
+// Deformation gradient (3 x 2): F = sum_a x_a beta_a^T.
+// Green strain E = (F^T F - I) / 2; second Piola-Kirchhoff stress (plane stress)
+//   S = S0 + lambda tr(E) I + 2 mu E,
+// with S0 the pre-stress of the rest configuration. Energy per unit rest area
+//   psi = S0 : E + mu E : E + lambda tr(E)^2 / 2,     U = A t psi.
+// Gradient: dU/dx_a = A t F S beta_a.
+// Hessian action on dx: dF = sum_a dx_a beta_a^T, dE = sym(F^T dF), dS = lambda tr(dE) I +
+//   2 mu dE, dP = dF S+ + F dS, d(dU/dx_a) = A t dP beta_a,
+// where S+ is S with its negative eigenvalues set to 0: the material part dE : C : dE is
+// positive semi-definite, and the geometric part tr(dF^T dF S+) is too, so Newton's steps are
+// descent directions even where the membrane is in compression (the true Hessian is not PSD).
+// Diagonal 3 x 3 block of node a:
+//   K_aa = A t [ (beta_a^T S+ beta_a) I + mu |beta_a|^2 F F^T + (mu + lambda) (F beta_a)(F
+//   beta_a)^T ].
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+
+namespace conform::membrane::detail {
+
+using Mat32 = Eigen::Matrix<double, 3, 2>;
+
+/// Constant per-element data, from the rest configuration and the material.
+struct ElementRest {
+  Eigen::Matrix2d beta;   // columns beta_1, beta_2 (beta_0 = -beta_1 - beta_2), 1/m
+  Eigen::Matrix2d s0;     // pre-stress in the element's frame, Pa
+  double area_thickness;  // A t, m^3
+};
+
+inline Eigen::Vector2d beta_of(const ElementRest& e, int corner) {
+  if (corner == 0) return -e.beta.col(0) - e.beta.col(1);
+  return e.beta.col(corner - 1);
+}
+
+inline Mat32 deformation_gradient(const ElementRest& e, const Eigen::Vector3d& x0,
+                                  const Eigen::Vector3d& x1, const Eigen::Vector3d& x2) {
+  Mat32 ds;
+  ds.col(0) = x1 - x0;
+  ds.col(1) = x2 - x0;
+  return ds * e.beta.transpose();  // F = Ds B, with B's rows beta_1^T, beta_2^T
+}
+
+inline Eigen::Matrix2d green_strain(const Mat32& f) {
+  return 0.5 * (f.transpose() * f - Eigen::Matrix2d::Identity());
+}
+
+inline Eigen::Matrix2d pk2_stress(const ElementRest& e, const Eigen::Matrix2d& strain,
+                                  double lambda, double mu) {
+  return e.s0 + lambda * strain.trace() * Eigen::Matrix2d::Identity() + 2 * mu * strain;
+}
+
+/// psi (J/m^2) of a strain.
+inline double energy_density(const ElementRest& e, const Eigen::Matrix2d& strain, double lambda,
+                             double mu) {
+  const double tr = strain.trace();
+  return (e.s0.cwiseProduct(strain)).sum() + mu * strain.squaredNorm() + 0.5 * lambda * tr * tr;
+}
+
+/// S with negative eigenvalues clamped to zero (2 x 2 symmetric, closed form).
+inline Eigen::Matrix2d positive_part(const Eigen::Matrix2d& s) {
+  const double a = s(0, 0), b = 0.5 * (s(0, 1) + s(1, 0)), c = s(1, 1);
+  const double mean = 0.5 * (a + c), radius = std::sqrt(0.25 * (a - c) * (a - c) + b * b);
+  const double l1 = mean + radius, l2 = mean - radius;
+  if (l2 >= 0) return s;
+  if (l1 <= 0) return Eigen::Matrix2d::Zero();
+  // Projector onto l1's eigenvector: (S - l2 I) / (l1 - l2).
+  Eigen::Matrix2d sym;
+  sym << a, b, b, c;
+  return l1 * (sym - l2 * Eigen::Matrix2d::Identity()) / (l1 - l2);
+}
+
+/// Per-iteration data of one element at the current positions.
+struct ElementState {
+  Mat32 f;                // deformation gradient
+  Eigen::Matrix2d s_pos;  // S+ (for the Hessian)
+  Mat32 p;                // first Piola-Kirchhoff stress F S (for the gradient)
+};
+
+inline ElementState element_state(const ElementRest& e, const Eigen::Vector3d& x0,
+                                  const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
+                                  double lambda, double mu) {
+  ElementState s;
+  s.f = deformation_gradient(e, x0, x1, x2);
+  const Eigen::Matrix2d stress = pk2_stress(e, green_strain(s.f), lambda, mu);
+  s.p = s.f * stress;
+  s.s_pos = positive_part(stress);
+  return s;
+}
+
+/// Hessian approximation times (dx0, dx1, dx2): the three 3-vectors written to out0..out2.
+inline void hessian_apply(const ElementRest& e, const ElementState& s, double lambda, double mu,
+                          const Eigen::Vector3d& d0, const Eigen::Vector3d& d1,
+                          const Eigen::Vector3d& d2, Eigen::Vector3d& out0, Eigen::Vector3d& out1,
+                          Eigen::Vector3d& out2) {
+  Mat32 ds;
+  ds.col(0) = d1 - d0;
+  ds.col(1) = d2 - d0;
+  const Mat32 df = ds * e.beta.transpose();
+  const Eigen::Matrix2d m = s.f.transpose() * df;
+  const Eigen::Matrix2d de = 0.5 * (m + m.transpose());
+  const Eigen::Matrix2d dstress = lambda * de.trace() * Eigen::Matrix2d::Identity() + 2 * mu * de;
+  const Mat32 dp = e.area_thickness * (df * s.s_pos + s.f * dstress);
+  out1 = dp * e.beta.col(0);
+  out2 = dp * e.beta.col(1);
+  out0 = -out1 - out2;
+}
+
+/// Diagonal 3 x 3 block of node `corner` of the Hessian approximation.
+inline Eigen::Matrix3d hessian_diagonal(const ElementRest& e, const ElementState& s, double lambda,
+                                        double mu, int corner) {
+  const Eigen::Vector2d b = beta_of(e, corner);
+  const Eigen::Vector3d fb = s.f * b;
+  return e.area_thickness *
+         ((b.dot(s.s_pos * b)) * Eigen::Matrix3d::Identity() +
+          mu * b.squaredNorm() * (s.f * s.f.transpose()) + (mu + lambda) * fb * fb.transpose());
+}
+
+}  // namespace conform::membrane::detail

@@ -1,0 +1,65 @@
+// The membrane of a triangle mesh: one constant-strain, pre-stressed St Venant-Kirchhoff
+// element per face (detail/cst_kernel.hpp has the formulas), built from the REST configuration
+// and the material only. Material that a topology change makes (new faces over new vertices,
+// whose rest positions are interpolated from their parents) therefore continues the material it
+// replaces: its rest state is never the current, stretched shape, and its pre-stress comes from
+// the same field.
+//
+// Shapes (#V vertices, #F faces): rest 3 x #V, faces #F counter-clockwise triangles.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "conform/membrane/detail/cst_kernel.hpp"
+#include "conform/membrane/skin_material.hpp"
+#include "conform/mesh/skinned_mesh.hpp"
+
+namespace conform::membrane {
+
+class Model {
+ public:
+  /// Builds the elements and the nodal areas. Faces whose rest area is below 1e-12 of the
+  /// squared longest edge carry no material (counted in degenerate_faces()); the material is
+  /// validated (SkinMaterial::validate throws on a bad field).
+  void build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<const mesh::Face> faces,
+             const SkinMaterial& material);
+
+  std::int32_t vertex_count() const { return static_cast<std::int32_t>(node_area_.size()); }
+  std::int32_t element_count() const { return static_cast<std::int32_t>(elements_.size()); }
+  std::int32_t degenerate_faces() const { return degenerate_; }
+  const SkinMaterial& material() const { return material_; }
+  double lambda() const { return lambda_; }
+  double mu() const { return mu_; }
+
+  /// A third of the rest area of the vertex's faces, m^2 (0 for a vertex without faces).
+  double node_area(std::int32_t v) const { return node_area_[static_cast<std::size_t>(v)]; }
+  /// rho_A times node_area, kg.
+  double node_mass(std::int32_t v) const { return material_.areal_density * node_area(v); }
+
+  /// Membrane energy at positions x (3 x #V), J.
+  double energy(const Eigen::Ref<const Eigen::Matrix3Xd>& x) const;
+  /// Membrane energy gradient (= minus the elastic nodal forces), N, written to g (3 x #V).
+  void gradient(const Eigen::Ref<const Eigen::Matrix3Xd>& x, Eigen::Ref<Eigen::Matrix3Xd> g) const;
+
+  // The solver's access to the elements (solver.cpp).
+  const std::vector<detail::ElementRest>& elements() const { return elements_; }
+  const std::vector<mesh::Face>& element_faces() const { return faces_; }
+  /// Incidence, CSR: the (element, corner) pairs of vertex v are
+  /// incidence()[incidence_start()[v] .. incidence_start()[v + 1]).
+  const std::vector<std::int32_t>& incidence_start() const { return incidence_start_; }
+  const std::vector<std::int32_t>& incidence() const { return incidence_; }  // 3 e + corner
+
+ private:
+  SkinMaterial material_;
+  double lambda_ = 0, mu_ = 0;
+  std::vector<detail::ElementRest> elements_;
+  std::vector<mesh::Face> faces_;
+  std::vector<double> node_area_;
+  std::vector<std::int32_t> incidence_start_, incidence_;
+  std::int32_t degenerate_ = 0;
+};
+
+}  // namespace conform::membrane

@@ -1,0 +1,81 @@
+// One implicit (backward Euler) step, or a static solve, of a membrane attached to its skinned
+// targets, solved to a residual: Newton's method on the step's incremental potential, each
+// Newton system solved by conjugate gradients with a 3 x 3 block-Jacobi preconditioner, and a
+// backtracking line search on the potential.
+//
+// The potential minimised over the free nodes' positions x (fixed nodes stay where they are):
+//   Phi(x) = U(x)                                           membrane (model.hpp)
+//          + sum_i 1/2 (x_i - T_i)^T K_i (x_i - T_i)          attachment to the targets T
+//          + sum_i m_i / (2 dt^2) |x_i - xp_i|^2              inertia (xp: predicted positions)
+//          + sum_i c A_i / (2 dt) |x_i - x0_i - dt vT_i|^2    damping relative to the targets
+// with K_i = A_i (k_t (I - n n^T) + k_n n n^T) (n the target's unit normal; n = 0 gives k_t I),
+// m_i = rho_A A_i and A_i the node's rest area. dt <= 0 drops inertia and damping: the static
+// equilibrium. The residual is the largest nodal force imbalance per unit node area, in Pa
+// (a traction), so the tolerance means the same on every mesh.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "conform/membrane/model.hpp"
+
+namespace conform::membrane {
+
+struct SolverSettings {
+  /// Stop when the largest |nodal force| / node area over the free nodes is below this, Pa.
+  double tolerance = 1.0;
+  int max_newton_iterations = 40;
+  int max_cg_iterations = 400;
+  /// Each Newton system is solved until its residual is below this fraction of the gradient.
+  double cg_relative_tolerance = 0.05;
+  /// OpenMP threads for the element and node loops of large meshes (1: serial). The results do
+  /// not depend on it (every sum is gathered per vertex in a fixed order).
+  int threads = 1;
+  /// Throws std::invalid_argument naming a field out of its range.
+  void validate() const;
+};
+
+struct StepInput {
+  /// Skinned targets T (3 x #V) and their unit normals (3 x #V, or empty: isotropic k_t).
+  Eigen::Ref<const Eigen::Matrix3Xd> targets;
+  Eigen::Ref<const Eigen::Matrix3Xd> target_normals;
+  /// Positions at the start of the step x0 and the targets' velocities vT (3 x #V each, or
+  /// empty when dt <= 0).
+  Eigen::Ref<const Eigen::Matrix3Xd> start;
+  Eigen::Ref<const Eigen::Matrix3Xd> target_velocities;
+  /// 1 where the node is fixed at its given position (kinematic, pinned or without faces).
+  std::span<const std::uint8_t> fixed;
+  /// Step, s; <= 0 for the static equilibrium.
+  double dt = 0;
+};
+
+struct SolveReport {
+  double initial_residual = 0;  // Pa, before the first Newton step
+  double residual = 0;          // Pa, at the returned positions
+  int newton_iterations = 0;
+  int cg_iterations = 0;  // summed over the Newton iterations
+  bool converged = false;
+};
+
+class Solver {
+ public:
+  Solver();
+  ~Solver();
+  Solver(Solver&&) noexcept;
+  Solver& operator=(Solver&&) noexcept;
+
+  /// x: in, the predicted positions xp (the initial guess; fixed nodes' values are kept);
+  /// out, the solution. Throws std::invalid_argument on mismatched shapes.
+  SolveReport solve(const Model& model, const StepInput& input, const SolverSettings& settings,
+                    Eigen::Ref<Eigen::Matrix3Xd> x);
+
+  struct Scratch;  // kept between calls: no allocation in a steady state (solver.cpp)
+
+ private:
+  std::unique_ptr<Scratch> scratch_;
+};
+
+}  // namespace conform::membrane

@@ -1,0 +1,107 @@
+#include "conform/membrane/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace conform::membrane {
+namespace {
+
+// The element's rest frame: e1 along the first edge, e2 = n x e1 in the face's plane.
+struct RestFrame {
+  Eigen::Vector3d e1, e2, normal;
+  Eigen::Matrix2d dm;  // [X1 - X0, X2 - X0] in (e1, e2)
+  double area = 0;
+};
+
+RestFrame rest_frame(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
+                     const Eigen::Vector3d& x2) {
+  RestFrame f;
+  const Eigen::Vector3d a = x1 - x0, b = x2 - x0, n = a.cross(b);
+  f.area = 0.5 * n.norm();
+  f.normal = n.normalized();
+  f.e1 = a.normalized();
+  f.e2 = f.normal.cross(f.e1);
+  f.dm << a.dot(f.e1), b.dot(f.e1), a.dot(f.e2), b.dot(f.e2);
+  return f;
+}
+
+// S0 = s1 a a^T + s2 b b^T in the frame, a the axis projected onto the face's plane.
+Eigen::Matrix2d prestress_in_frame(const SkinMaterial& m, const RestFrame& f) {
+  const Eigen::Vector3d axis = m.prestress_axis.normalized();
+  Eigen::Vector2d a(axis.dot(f.e1), axis.dot(f.e2));
+  if (a.norm() < 1e-6) a = Eigen::Vector2d::UnitX();  // axis normal to the face: first edge
+  a.normalize();
+  const Eigen::Vector2d b(-a.y(), a.x());
+  return m.prestress[0] * a * a.transpose() + m.prestress[1] * b * b.transpose();
+}
+
+}  // namespace
+
+void Model::build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<const mesh::Face> faces,
+                  const SkinMaterial& material) {
+  material.validate();
+  material_ = material;
+  lambda_ = material.lame_lambda();
+  mu_ = material.lame_mu();
+  const auto nv = static_cast<std::size_t>(rest.cols());
+  elements_.clear();
+  faces_.clear();
+  elements_.reserve(faces.size());
+  faces_.reserve(faces.size());
+  node_area_.assign(nv, 0.0);
+  degenerate_ = 0;
+  for (const mesh::Face& face : faces) {
+    const Eigen::Vector3d x0 = rest.col(face[0]), x1 = rest.col(face[1]), x2 = rest.col(face[2]);
+    const double longest =
+        std::max({(x1 - x0).squaredNorm(), (x2 - x1).squaredNorm(), (x0 - x2).squaredNorm()});
+    const RestFrame frame = rest_frame(x0, x1, x2);
+    if (!(frame.area > 1e-12 * longest)) {
+      ++degenerate_;
+      continue;
+    }
+    detail::ElementRest e;
+    e.beta = frame.dm.inverse().transpose();  // columns = rows of Dm^-1
+    e.s0 = prestress_in_frame(material, frame);
+    e.area_thickness = frame.area * material.thickness;
+    elements_.push_back(e);
+    faces_.push_back(face);
+    for (const std::int32_t v : face) node_area_[static_cast<std::size_t>(v)] += frame.area / 3;
+  }
+  // Vertex -> (element, corner) incidence, CSR.
+  incidence_start_.assign(nv + 1, 0);
+  for (const mesh::Face& face : faces_)
+    for (const std::int32_t v : face) ++incidence_start_[static_cast<std::size_t>(v) + 1];
+  for (std::size_t v = 0; v < nv; ++v) incidence_start_[v + 1] += incidence_start_[v];
+  incidence_.resize(3 * faces_.size());
+  std::vector<std::int32_t> fill(incidence_start_.begin(), incidence_start_.end() - 1);
+  for (std::size_t e = 0; e < faces_.size(); ++e)
+    for (int c = 0; c < 3; ++c)
+      incidence_[static_cast<std::size_t>(fill[static_cast<std::size_t>(faces_[e][c])]++)] =
+          static_cast<std::int32_t>(3 * e) + c;
+}
+
+double Model::energy(const Eigen::Ref<const Eigen::Matrix3Xd>& x) const {
+  double total = 0;
+  for (std::size_t e = 0; e < elements_.size(); ++e) {
+    const mesh::Face& f = faces_[e];
+    const detail::Mat32 F =
+        detail::deformation_gradient(elements_[e], x.col(f[0]), x.col(f[1]), x.col(f[2]));
+    total += elements_[e].area_thickness *
+             detail::energy_density(elements_[e], detail::green_strain(F), lambda_, mu_);
+  }
+  return total;
+}
+
+void Model::gradient(const Eigen::Ref<const Eigen::Matrix3Xd>& x,
+                     Eigen::Ref<Eigen::Matrix3Xd> g) const {
+  g.setZero();
+  for (std::size_t e = 0; e < elements_.size(); ++e) {
+    const mesh::Face& f = faces_[e];
+    const detail::ElementState s =
+        detail::element_state(elements_[e], x.col(f[0]), x.col(f[1]), x.col(f[2]), lambda_, mu_);
+    for (int c = 0; c < 3; ++c)
+      g.col(f[c]) += elements_[e].area_thickness * s.p * detail::beta_of(elements_[e], c);
+  }
+}
+
+}  // namespace conform::membrane

@@ -1,0 +1,52 @@
+#include "conform/membrane/skin_material.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace conform::membrane {
+namespace {
+
+void require(bool ok, const char* field, double value, const char* range) {
+  if (ok) return;
+  std::ostringstream out;
+  out << "skin material: " << field << " = " << value << " is out of range (" << range << ")";
+  throw std::invalid_argument(out.str());
+}
+
+}  // namespace
+
+double SkinMaterial::lame_lambda() const {
+  return youngs_modulus * poisson_ratio / (1 - poisson_ratio * poisson_ratio);
+}
+
+double SkinMaterial::lame_mu() const {
+  return youngs_modulus / (2 * (1 + poisson_ratio));
+}
+
+void SkinMaterial::validate() const {
+  const auto finite = [](double v) { return std::isfinite(v); };
+  require(finite(youngs_modulus) && youngs_modulus > 0, "youngs_modulus", youngs_modulus, "> 0 Pa");
+  require(finite(poisson_ratio) && poisson_ratio >= 0 && poisson_ratio < 0.5, "poisson_ratio",
+          poisson_ratio, "[0, 0.5)");
+  require(finite(thickness) && thickness > 0, "thickness", thickness, "> 0 m");
+  require(finite(areal_density) && areal_density > 0, "areal_density", areal_density, "> 0 kg/m^2");
+  for (int i = 0; i < 2; ++i)
+    require(finite(prestress[i]) && prestress[i] >= 0 && prestress[i] < youngs_modulus,
+            i == 0 ? "prestress[0]" : "prestress[1]", prestress[i], "[0, youngs_modulus) Pa");
+  require(prestress_axis.allFinite() && prestress_axis.norm() > 0, "prestress_axis (norm)",
+          prestress_axis.norm(), "a finite, non-zero direction");
+  require(finite(attachment_stiffness) && attachment_stiffness >= 0, "attachment_stiffness",
+          attachment_stiffness, ">= 0 Pa/m");
+  require(finite(attachment_normal_stiffness) && attachment_normal_stiffness >= 0,
+          "attachment_normal_stiffness", attachment_normal_stiffness, ">= 0 Pa/m");
+  require(finite(attachment_damping) && attachment_damping >= 0, "attachment_damping",
+          attachment_damping, ">= 0 Pa s/m");
+}
+
+double equibiaxial_prestress(const SkinMaterial& material, double prestrain) {
+  return material.youngs_modulus * prestrain / (1 - material.poisson_ratio);
+}
+
+}  // namespace conform::membrane
