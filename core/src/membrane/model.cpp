@@ -78,6 +78,39 @@ void Model::build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<cons
     for (int c = 0; c < 3; ++c)
       incidence_[static_cast<std::size_t>(fill[static_cast<std::size_t>(faces_[e][c])]++)] =
           static_cast<std::int32_t>(3 * e) + c;
+  build_block_pattern();
+}
+
+void Model::build_block_pattern() {
+  const std::size_t nv = node_area_.size();
+  block_start_.assign(nv + 1, 0);
+  block_column_.clear();
+  diagonal_block_.assign(nv, -1);
+  std::vector<std::int32_t> row;
+  for (std::size_t v = 0; v < nv; ++v) {  // the vertex and its face neighbours, sorted
+    row.clear();
+    for (std::int32_t k = incidence_start_[v]; k < incidence_start_[v + 1]; ++k)
+      for (const std::int32_t u : faces_[std::size_t(incidence_[std::size_t(k)] / 3)])
+        row.push_back(u);
+    if (row.empty()) row.push_back(std::int32_t(v));
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+    for (const std::int32_t u : row) {
+      if (u == std::int32_t(v)) diagonal_block_[v] = std::int32_t(block_column_.size());
+      block_column_.push_back(u);
+    }
+    block_start_[v + 1] = std::int32_t(block_column_.size());
+  }
+  element_block_.resize(9 * faces_.size());
+  for (std::size_t e = 0; e < faces_.size(); ++e)
+    for (int a = 0; a < 3; ++a) {
+      const auto v = std::size_t(faces_[e][a]);
+      const auto first = block_column_.begin() + block_start_[v],
+                 last = block_column_.begin() + block_start_[v + 1];
+      for (int b = 0; b < 3; ++b)
+        element_block_[9 * e + 3 * std::size_t(a) + std::size_t(b)] =
+            std::int32_t(std::lower_bound(first, last, faces_[e][b]) - block_column_.begin());
+    }
 }
 
 double Model::energy(const Eigen::Ref<const Eigen::Matrix3Xd>& x) const {

@@ -38,8 +38,8 @@ void SolverSettings::validate() const {
 
 struct Solver::Scratch {
   std::vector<detail::ElementState> states_;
-  std::vector<Eigen::Matrix3d> node_stiffness_, block_inverse_;
-  std::vector<Eigen::Vector3d> element_out_;
+  std::vector<Eigen::Matrix3d> node_stiffness_, block_inverse_, blocks_;
+  std::vector<std::uint8_t> free_;  // per vertex: moves in this solve
   Eigen::Matrix3Xd predicted_, gradient_, step_, r_, z_, p_, q_, trial_;
   Eigen::VectorXd inertia_weight_;
 };
@@ -153,60 +153,55 @@ double residual(const Context& c, const Eigen::Matrix3Xd& g) {
   return worst;
 }
 
-// Phase 4: the block-Jacobi preconditioner, inverses of the 3 x 3 diagonal blocks.
-void build_preconditioner(Context& c) {
+// Phase 4: assemble the Hessian approximation's 3 x 3 blocks (element blocks, then the nodal
+// attachment and inertia terms on the diagonal) and invert the diagonal blocks (block-Jacobi).
+// Rows and columns of fixed nodes are left out by hessian_apply.
+void assemble(Context& c) {
   const auto& elements = c.model.elements();
-  const auto& start = c.model.incidence_start();
-  const auto& inc = c.model.incidence();
-  c.s.block_inverse_.resize(static_cast<std::size_t>(c.nv));
+  const auto& element_block = c.model.element_block();
+  const auto& diagonal = c.model.diagonal_block();
   const double lambda = c.model.lambda(), mu = c.model.mu();
-#pragma omp parallel for schedule(static) \
-    num_threads(c.threads) if (c.threads > 1 && c.ne > kParallelElements)
+  c.s.blocks_.assign(c.model.block_column().size(), Eigen::Matrix3d::Zero());
+  for (std::int64_t e = 0; e < c.ne; ++e) {
+    const detail::ElementRest& rest = elements[std::size_t(e)];
+    const detail::ElementState& state = c.s.states_[std::size_t(e)];
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        c.s.blocks_[std::size_t(element_block[std::size_t(9 * e + 3 * a + b)])] +=
+            detail::hessian_block(rest, state, lambda, mu, a, b);
+  }
+  c.s.block_inverse_.resize(static_cast<std::size_t>(c.nv));
   for (std::int64_t v = 0; v < c.nv; ++v) {
+    Eigen::Matrix3d& k = c.s.blocks_[std::size_t(diagonal[std::size_t(v)])];
+    k += c.s.node_stiffness_[std::size_t(v)];
+    if (c.dynamic) k.diagonal().array() += c.s.inertia_weight_[v];
     if (c.fixed(v)) {
       c.s.block_inverse_[std::size_t(v)].setZero();
       continue;
     }
-    Eigen::Matrix3d k = c.s.node_stiffness_[std::size_t(v)];
-    if (c.dynamic) k.diagonal().array() += c.s.inertia_weight_[v];
-    for (std::int32_t j = start[std::size_t(v)]; j < start[std::size_t(v) + 1]; ++j) {
-      const std::int32_t e = inc[std::size_t(j)] / 3, corner = inc[std::size_t(j)] % 3;
-      k += detail::hessian_diagonal(elements[std::size_t(e)], c.s.states_[std::size_t(e)], lambda,
-                                    mu, corner);
-    }
-    k.diagonal().array() += 1e-12 * k.trace() + 1e-300;  // keeps a lone node invertible
-    c.s.block_inverse_[std::size_t(v)] = k.inverse();
+    const Eigen::Matrix3d regular =
+        k + (1e-12 * k.trace() + 1e-300) * Eigen::Matrix3d::Identity();  // a lone node
+    c.s.block_inverse_[std::size_t(v)] = regular.inverse();
   }
 }
 
-// out = H d (H the PSD Hessian approximation; rows and columns of fixed nodes are zero).
+// out = H d over the free nodes (d's fixed entries are read as zero, out's are zero).
 void hessian_apply(Context& c, const Eigen::Matrix3Xd& d, Eigen::Matrix3Xd& out) {
-  const auto& elements = c.model.elements();
-  const auto& faces = c.model.element_faces();
-  const auto& start = c.model.incidence_start();
-  const auto& inc = c.model.incidence();
-  const double lambda = c.model.lambda(), mu = c.model.mu();
-  c.s.element_out_.resize(static_cast<std::size_t>(3 * c.ne));
-#pragma omp parallel for schedule(static) \
-    num_threads(c.threads) if (c.threads > 1 && c.ne > kParallelElements)
-  for (std::int64_t e = 0; e < c.ne; ++e) {
-    const mesh::Face& f = faces[std::size_t(e)];
-    Eigen::Vector3d* o = &c.s.element_out_[std::size_t(3 * e)];
-    detail::hessian_apply(elements[std::size_t(e)], c.s.states_[std::size_t(e)], lambda, mu,
-                          d.col(f[0]), d.col(f[1]), d.col(f[2]), o[0], o[1], o[2]);
-  }
+  const auto& start = c.model.block_start();
+  const auto& column = c.model.block_column();
   out.resize(3, c.nv);
 #pragma omp parallel for schedule(static) \
     num_threads(c.threads) if (c.threads > 1 && c.ne > kParallelElements)
   for (std::int64_t v = 0; v < c.nv; ++v) {
-    if (c.fixed(v)) {
-      out.col(v).setZero();
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    if (!c.s.free_[std::size_t(v)]) {
+      out.col(v) = sum;
       continue;
     }
-    Eigen::Vector3d sum = c.s.node_stiffness_[std::size_t(v)] * d.col(v);
-    if (c.dynamic) sum += c.s.inertia_weight_[v] * d.col(v);
-    for (std::int32_t j = start[std::size_t(v)]; j < start[std::size_t(v) + 1]; ++j)
-      sum += c.s.element_out_[std::size_t(inc[std::size_t(j)])];
+    for (std::int32_t j = start[std::size_t(v)]; j < start[std::size_t(v) + 1]; ++j) {
+      const std::int32_t u = column[std::size_t(j)];
+      if (c.s.free_[std::size_t(u)]) sum += c.s.blocks_[std::size_t(j)] * d.col(u);
+    }
     out.col(v) = sum;
   }
 }
@@ -280,6 +275,8 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
   }
   if (!x.allFinite()) throw std::invalid_argument("membrane solve: x holds a non-finite value");
   prepare_nodes(c, x);
+  s.free_.resize(std::size_t(nv));
+  for (Eigen::Index v = 0; v < nv; ++v) s.free_[std::size_t(v)] = !c.fixed(v);
   SolveReport report;
   for (;; ++report.newton_iterations) {
     evaluate_elements(c, x);
@@ -291,7 +288,7 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
       break;
     }
     if (report.newton_iterations == settings.max_newton_iterations) break;
-    build_preconditioner(c);
+    assemble(c);
     report.cg_iterations += conjugate_gradients(c, s.gradient_, s.step_);
     if (!line_search(c, x, s.gradient_, s.step_, potential(c, x))) break;
   }

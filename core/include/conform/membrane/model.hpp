@@ -51,6 +51,13 @@ class Model {
   /// incidence()[incidence_start()[v] .. incidence_start()[v + 1]).
   const std::vector<std::int32_t>& incidence_start() const { return incidence_start_; }
   const std::vector<std::int32_t>& incidence() const { return incidence_; }  // 3 e + corner
+  /// The Hessian's 3 x 3 block pattern, CSR by vertex: row v's blocks are
+  /// [block_start()[v], block_start()[v + 1]) with columns block_column(); element e's block
+  /// (a, b) is block element_block()[9 e + 3 a + b]; row v's diagonal block is diagonal_block()[v].
+  const std::vector<std::int32_t>& block_start() const { return block_start_; }
+  const std::vector<std::int32_t>& block_column() const { return block_column_; }
+  const std::vector<std::int32_t>& element_block() const { return element_block_; }
+  const std::vector<std::int32_t>& diagonal_block() const { return diagonal_block_; }
 
  private:
   SkinMaterial material_;
@@ -59,6 +66,8 @@ class Model {
   std::vector<mesh::Face> faces_;
   std::vector<double> node_area_;
   std::vector<std::int32_t> incidence_start_, incidence_;
+  std::vector<std::int32_t> block_start_, block_column_, element_block_, diagonal_block_;
+  void build_block_pattern();
   std::int32_t degenerate_ = 0;
 };
 

@@ -111,14 +111,14 @@ inline void hessian_apply(const ElementRest& e, const ElementState& s, double la
   out0 = -out1 - out2;
 }
 
-/// Diagonal 3 x 3 block of node `corner` of the Hessian approximation.
-inline Eigen::Matrix3d hessian_diagonal(const ElementRest& e, const ElementState& s, double lambda,
-                                        double mu, int corner) {
-  const Eigen::Vector2d b = beta_of(e, corner);
-  const Eigen::Vector3d fb = s.f * b;
-  return e.area_thickness *
-         ((b.dot(s.s_pos * b)) * Eigen::Matrix3d::Identity() +
-          mu * b.squaredNorm() * (s.f * s.f.transpose()) + (mu + lambda) * fb * fb.transpose());
+/// Block (a, b) of the Hessian approximation (corners a, b in 0..2).
+inline Eigen::Matrix3d hessian_block(const ElementRest& e, const ElementState& s, double lambda,
+                                     double mu, int a, int b) {
+  const Eigen::Vector2d ba = beta_of(e, a), bb = beta_of(e, b);
+  const Eigen::Vector3d fa = s.f * ba, fb = s.f * bb;
+  return e.area_thickness * ((ba.dot(s.s_pos * bb)) * Eigen::Matrix3d::Identity() +
+                             mu * ba.dot(bb) * (s.f * s.f.transpose()) + mu * fb * fa.transpose() +
+                             lambda * fa * fb.transpose());
 }
 
 }  // namespace conform::membrane::detail
