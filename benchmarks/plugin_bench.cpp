@@ -29,7 +29,9 @@ struct LiveArm {
   bullet::SkinnedSoftBody* body;
   explicit LiveArm(int warmup = 10, double pretension = 0.05) {
     const auto& arm = the_arm();
-    body = &plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = pretension});
+    body = &plugin.add_skinned_body(
+        arm.mesh, arm.skeleton,
+        {.model = bullet::MaterialModel::bullet_links, .pretension = pretension});
     skin::PoseTrack track;
     track.set_key(0, skin::Pose::rest(arm.skeleton));
     track.set_key(1, conform::test::bent_arm_pose(arm.skeleton, 0.7, 1.2));
@@ -86,7 +88,7 @@ void BM_StepUnskinned(benchmark::State& state) {
   bullet::SkinnedSoftBody body(
       w.world.getWorldInfo(), [&](btSoftBody* b) { w.world.addSoftBody(b); },
       [&](btSoftBody* b) { w.world.removeSoftBody(b); }, arm.mesh, arm.skeleton,
-      {.pretension = pretension});
+      {.model = bullet::MaterialModel::bullet_links, .pretension = pretension});
   w.step(10);
   for (auto _ : state) w.step();
   state.counters["nodes"] = body.vertex_count();

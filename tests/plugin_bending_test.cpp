@@ -23,7 +23,8 @@ mesh::SkinnedMesh patch(int cells) {
 
 bullet::Material free_sheet(double bending) {
   bullet::Material material;
-  material.kinematic_weight = 2;  // only pinned vertices are kinematic
+  material.model = bullet::MaterialModel::bullet_links;  // the links' pretension opens it
+  material.kinematic_weight = 2;                         // only pinned vertices are kinematic
   material.target_stiffness = 0;  // no pull toward the (flat) skinned targets
   material.target_damping = 0;
   material.damping = 0.05;

@@ -57,6 +57,7 @@ mesh::SkinnedMesh patch() {
 Profile tear_and_settle(double pretension, SoftWorld& w, bullet::Plugin& plugin) {
   const mesh::SkinnedMesh m = patch();
   bullet::Material material;
+  material.model = bullet::MaterialModel::bullet_links;  // the links' pretension opens it
   material.pretension = pretension;
   material.kinematic_weight = 2;  // nothing kinematic by weight: only the pinned border
   material.target_stiffness = 0;  // a free membrane

@@ -77,10 +77,13 @@ TEST(PluginSkinnedBody, ValidatesWorldAndInput) {
   bad = arm.mesh;
   bad.bones(0, 5) = 7;
   EXPECT_THROW(plugin.add_skinned_body(bad, arm.skeleton), std::invalid_argument);
-  EXPECT_THROW(plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = 1.0}),
-               std::invalid_argument);
+  EXPECT_THROW(
+      plugin.add_skinned_body(arm.mesh, arm.skeleton,
+                              {.model = bullet::MaterialModel::bullet_links, .pretension = 1.0}),
+      std::invalid_argument);
   EXPECT_EQ(plugin.skinned_body_count(), 0u);
-  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
+  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton,
+                                       {.model = bullet::MaterialModel::bullet_links});
   EXPECT_EQ(plugin.skinned_body_count(), 1u);
   EXPECT_EQ(body.piece_count(), 1);
   EXPECT_EQ(w.world.getSoftBodyArray().size(), 1);
@@ -92,7 +95,7 @@ TEST(PluginSkinnedBody, BuildsNodesLinksFacesAndMasses) {
   SoftWorld w;
   bullet::Plugin plugin(w.world);
   const auto arm = mesh::make_arm(1);
-  const bullet::Material material{.density = 1.3};
+  const bullet::Material material{.model = bullet::MaterialModel::bullet_links, .density = 1.3};
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, material);
   btSoftBody* sb = body.pieces().at(0);
   EXPECT_EQ(sb->m_nodes.size(), arm.mesh.vertex_count());
@@ -120,7 +123,8 @@ TEST(PluginSkinnedBody, KinematicNodesTrackTheirCgaSkinnedTargetsExactly) {
   SoftWorld w(9.81);
   bullet::Plugin plugin(w.world);
   const auto arm = mesh::make_arm(1);
-  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
+  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton,
+                                       {.model = bullet::MaterialModel::bullet_links});
   const auto track = bending_track(arm.skeleton);
   body.set_keyframes(track);
   for (int step = 1; step <= 60; ++step) {
@@ -147,7 +151,9 @@ TEST(PluginSkinnedBody, FreeNodesConvergeToTheirTargets) {
   bullet::Plugin plugin(w.world);
   const auto arm = mesh::make_arm(1);
   // Only the shoulder end is kinematic; everything else follows by the per-node pull.
-  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, {.kinematic_weight = 2.0});
+  auto& body = plugin.add_skinned_body(
+      arm.mesh, arm.skeleton,
+      {.model = bullet::MaterialModel::bullet_links, .kinematic_weight = 2.0});
   std::vector<std::int32_t> pinned;
   for (std::int32_t v = 0; v < arm.mesh.vertex_count(); ++v)
     if (arm.mesh.rest(2, v) < 0.05) pinned.push_back(v);
@@ -181,7 +187,8 @@ TEST(PluginSkinnedBody, PretensionSurvivesBulletsRestLengthReset) {
   bullet::Plugin plugin(w.world);
   const auto arm = mesh::make_arm({.segments = 16, .rings = 40});
   const double s = 0.2;
-  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = s});
+  auto& body = plugin.add_skinned_body(
+      arm.mesh, arm.skeleton, {.model = bullet::MaterialModel::bullet_links, .pretension = s});
   auto check = [&](const char* when) {
     for (btSoftBody* sb : body.pieces()) {
       sb->m_bUpdateRtCst = true;  // as after any edit: Bullet resets rest lengths next step
@@ -223,7 +230,8 @@ TEST(PluginSkinnedBody, AnimatedModelFromAFile) {
   ASSERT_FALSE(model.animations.empty());
   SoftWorld w;
   bullet::Plugin plugin(w.world);
-  auto& body = plugin.add_skinned_body(model, {.kinematic_weight = 0.5});
+  auto& body = plugin.add_skinned_body(
+      model, {.model = bullet::MaterialModel::bullet_links, .kinematic_weight = 0.5});
   body.play(model.animations[0]);
   w.step(20);
   skin::Pose pose = skin::Pose::rest(model.skeleton);

@@ -46,7 +46,8 @@ TEST(PluginStability, ThousandRandomEventsOnARunningArm) {
   SoftWorld w;
   bullet::Plugin plugin(w.world);
   const auto arm = mesh::make_arm(1);
-  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, {.pretension = 0.05});
+  auto& body = plugin.add_skinned_body(
+      arm.mesh, arm.skeleton, {.model = bullet::MaterialModel::bullet_links, .pretension = 0.05});
   skin::PoseTrack track;
   track.set_key(0, skin::Pose::rest(arm.skeleton));
   track.set_key(4, pose_at(arm.skeleton, 0.6, 1.3));

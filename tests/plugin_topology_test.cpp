@@ -170,7 +170,9 @@ struct LiveArm {
   skin::PoseTrack track;
   explicit LiveArm(double bending = 0) {
     body = &plugin.add_skinned_body(arm.mesh, arm.skeleton,
-                                    {.pretension = 0.1, .bending_stiffness = bending});
+                                    {.model = bullet::MaterialModel::bullet_links,
+                                     .pretension = 0.1,
+                                     .bending_stiffness = bending});
     track.set_key(0, skin::Pose::rest(arm.skeleton));
     track.set_key(2, conform::test::bent_arm_pose(arm.skeleton, 0.8, 1.2));
     body->set_keyframes(track);
@@ -387,8 +389,9 @@ TEST(PluginTopology, SplitSearchStaysLocalForHolesAndFindsEverySplit) {
   SoftWorld w;
   bullet::Plugin plugin(w.world);
   const mesh::SkinnedMesh sheet = test::one_bone_sheet(40, 40, 1.0, 1.0);
-  auto& body = plugin.add_skinned_body(sheet, test::one_bone_skeleton(),
-                                       {.pretension = 0.1, .kinematic_weight = 2});
+  auto& body = plugin.add_skinned_body(
+      sheet, test::one_bone_skeleton(),
+      {.model = bullet::MaterialModel::bullet_links, .pretension = 0.1, .kinematic_weight = 2});
   w.step(3);
   auto near = [](double x, double y, double r) {
     return [=](const Eigen::Vector3d& c) { return std::hypot(c.x() - x, c.y() - y) < r; };

@@ -79,8 +79,10 @@ double seconds_since(double& t) {
 }
 
 // Bullet's link constant c0 = (1/m_a + 1/m_b) / kLST (what its updateLinkConstants writes).
+// A material with kLST = 0 (the membrane's links) gets c0 = 0, which Bullet's link solve skips.
 void link_constant(btSoftBody::Link& l) {
-  l.m_c0 = (l.m_n[0]->m_im + l.m_n[1]->m_im) / l.m_material->m_kLST;
+  const btScalar k = l.m_material->m_kLST;
+  l.m_c0 = k > 0 ? (l.m_n[0]->m_im + l.m_n[1]->m_im) / k : btScalar(0);
 }
 
 // Bullet's face m_ra: twice the triangle's area (its AreaOf).
@@ -253,6 +255,11 @@ SkinnedSoftBody::Impl::Impl(btSoftBodyWorldInfo& info, std::function<void(btSoft
   if (!(material_.pretension >= 0 && material_.pretension < 1))
     throw std::invalid_argument("SkinnedSoftBody: pretension must be in [0, 1)");
   if (!(material_.density > 0)) throw std::invalid_argument("SkinnedSoftBody: density must be > 0");
+  if (membrane_model()) {
+    material_.skin.validate();  // throws naming the field
+    material_.solver.validate();
+    material_.density = material_.skin.areal_density;  // the books' masses are the membrane's
+  }
   if (!(material_.link_stiffness > 0 && material_.link_stiffness <= 1))
     throw std::invalid_argument("SkinnedSoftBody: link_stiffness must be in (0, 1]");
   if (!(material_.bending_stiffness >= 0 && material_.bending_stiffness <= 1))
@@ -296,7 +303,7 @@ SkinnedSoftBody::Impl::~Impl() {
 }
 
 bool SkinnedSoftBody::Impl::is_kinematic_by_weight(std::int32_t v) const {
-  return mesh_.weights(0, v) >= material_.kinematic_weight;
+  return !membrane_model() && mesh_.weights(0, v) >= material_.kinematic_weight;
 }
 
 SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece() {
@@ -304,7 +311,8 @@ SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece() {
   // This constructor (unlike the world-info-only one) creates the default material.
   piece->body = std::make_unique<btSoftBody>(info_, 0, nullptr, nullptr);
   btSoftBody& body = *piece->body;
-  body.m_materials[0]->m_kLST = btScalar(material_.link_stiffness);
+  // The membrane's links only carry the topology (inert, c0 = 0).
+  body.m_materials[0]->m_kLST = membrane_model() ? btScalar(0) : btScalar(material_.link_stiffness);
   if (material_.bending_stiffness > 0)
     body.appendMaterial()->m_kLST = btScalar(material_.bending_stiffness);  // material 1
   body.m_cfg.kDP = btScalar(material_.damping);
@@ -897,6 +905,7 @@ std::int32_t SkinnedSoftBody::Impl::move_to_new_piece(std::span<const std::int32
 }
 
 void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
+  membrane_.invalidate();
   auto clock = Clock::now();
   auto& sec = stats_.seconds;
   const std::int32_t v0 = change.base_vertex_count;
@@ -1590,6 +1599,10 @@ void SkinnedSoftBody::Impl::update(double dt, double time) {
         tp(previous_target_.x[v], previous_target_.y[v], previous_target_.z[v]);
     detached_state_[slot] = {t, (t - tp) / dt};
   }
+  if (membrane_model()) {
+    step_membrane(dt);
+    return;
+  }
   const double k = material_.target_stiffness, c = material_.target_damping;
   const double dt2 = dt * dt, denom = 1 + c * dt + k * dt2;
   const bool pull = k > 0 || c > 0;
@@ -1627,7 +1640,39 @@ void SkinnedSoftBody::Impl::update(double dt, double time) {
   }
 }
 
+// Kinematic nodes on their targets; then the membrane's step for the others (membrane_drive.hpp).
+void SkinnedSoftBody::Impl::step_membrane(double dt) {
+  const auto n = static_cast<std::size_t>(mesh_.vertex_count());
+  vertex_node_.assign(n, nullptr);
+  target_matrix_.resize(3, Eigen::Index(n));
+  previous_matrix_.resize(3, Eigen::Index(n));
+  for (std::size_t v = 0; v < n; ++v) {
+    target_matrix_.col(Eigen::Index(v)) << target_.x[v], target_.y[v], target_.z[v];
+    previous_matrix_.col(Eigen::Index(v)) << previous_target_.x[v], previous_target_.y[v],
+        previous_target_.z[v];
+  }
+  for (auto& piece : pieces_) {
+    if (!piece) continue;
+    btSoftBody& body = *piece->body;
+    for (int i = 0; i < body.m_nodes.size(); ++i) {
+      btSoftBody::Node& node = body.m_nodes[i];
+      const auto v = static_cast<std::size_t>(piece->node_vertex[static_cast<std::size_t>(i)]);
+      vertex_node_[v] = &node;
+      if (!kinematic_[v]) continue;
+      const btVector3 t(btScalar(target_.x[v]), btScalar(target_.y[v]), btScalar(target_.z[v]));
+      node.m_x = t;  // after Bullet's prediction: on the target; Bullet derives the velocity
+      node.m_v = (t - node.m_q) / btScalar(dt);
+    }
+  }
+  membrane_.step(mesh_, material_.skin, material_.solver, vertex_node_, kinematic_, mass_,
+                 target_matrix_, previous_matrix_, dt);
+}
+
 // --- Queries ---
+
+const membrane::SolveReport& SkinnedSoftBody::last_solve() const {
+  return impl_->membrane_.last_report();
+}
 
 std::int32_t SkinnedSoftBody::Impl::piece_count() const {
   return std::int32_t(std::count_if(pieces_.begin(), pieces_.end(),

@@ -16,6 +16,7 @@
 #include "conform/mesh/adjacency.hpp"
 #include "conform/mesh/face_index.hpp"
 #include "conform/skin/skinning.hpp"
+#include "membrane_drive.hpp"
 
 namespace conform::bullet {
 
@@ -167,6 +168,13 @@ struct SkinnedSoftBody::Impl {
   std::vector<std::uint8_t> area_mark_, seed_mark_;  // per vertex scratch, 0 between changes
   // Edges whose bending link may have to be made again at the end of a change.
   std::vector<std::pair<std::int32_t, std::int32_t>> bend_dirty_;
+
+  // The membrane (Material::model == membrane) and its per-substep inputs.
+  bool membrane_model() const { return material_.model == MaterialModel::membrane; }
+  void step_membrane(double dt);
+  MembraneDrive membrane_;
+  std::vector<void*> vertex_node_;
+  Eigen::Matrix3Xd target_matrix_, previous_matrix_;
 
   std::vector<std::unique_ptr<Piece>> pieces_;  // null once emptied
   ApplyStats stats_;

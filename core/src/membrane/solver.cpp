@@ -85,7 +85,8 @@ void prepare_nodes(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
     }
     s.node_stiffness_[static_cast<std::size_t>(v)] = k;
     if (!c.dynamic) continue;
-    const double dt = c.in.dt, inertia = m.areal_density * area / (dt * dt),
+    const double mass = c.in.masses.empty() ? m.areal_density * area : c.in.masses[std::size_t(v)];
+    const double dt = c.in.dt, inertia = mass / (dt * dt),
                  damping = m.attachment_damping * area / dt, w = inertia + damping;
     s.inertia_weight_[v] = w;
     if (w > 0)
@@ -269,6 +270,10 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
   Context c{model,        input,           settings, *scratch_, nv, model.element_count(),
             input.dt > 0, settings.threads};
   Scratch& s = *scratch_;
+  if (!input.masses.empty() && input.masses.size() != static_cast<std::size_t>(nv))
+    throw std::invalid_argument("membrane solve: masses has " +
+                                std::to_string(input.masses.size()) + " entries, the model has " +
+                                std::to_string(nv) + " vertices");
   if (c.dynamic) {
     require_cols(input.start, nv, false, "start");
     require_cols(input.target_velocities, nv, false, "target_velocities");

@@ -50,6 +50,9 @@ struct StepInput {
   std::span<const std::uint8_t> fixed;
   /// Step, s; <= 0 for the static equilibrium.
   double dt = 0;
+  /// Node masses, kg (empty: rho_A times the node's rest area). A host whose edits split and
+  /// conserve mass (the Bullet plugin) passes its own books, so inertia and momentum agree.
+  std::span<const double> masses = {};
 };
 
 struct SolveReport {

@@ -19,11 +19,15 @@
 // Each substep (in the plugin's action, after Bullet's motion prediction and before its
 // constraint solve) the pose source gives a skeleton pose, CGA skinning gives every vertex its
 // target, and
-//   kinematic nodes (largest bone weight ≥ Material::kinematic_weight, or pinned) are placed on
-//     their target (Bullet inverse mass 0; velocity (target − previous) / dt);
-//   free nodes are pulled toward their target by an implicit spring–damper per node;
-//   every link's rest length is re-applied from our own copy (Bullet resets rest lengths to the
-//     current lengths after any edit, which would wipe pretension).
+//   kinematic nodes (pinned; with bullet_links also those whose largest bone weight is ≥
+//     Material::kinematic_weight) are placed on their target (Bullet inverse mass 0; velocity
+//     (target − previous) / dt);
+//   membrane (the default): the free nodes take one backward-Euler step of the skin membrane
+//     attached to the targets, solved to Material::solver.tolerance (last_solve()); Bullet's
+//     links are inert (their constant c0 is 0) and its contacts act on the result;
+//   bullet_links: free nodes are pulled toward their target by an implicit spring–damper per
+//     node, and every link's rest length is re-applied from our own copy (Bullet resets rest
+//     lengths to the current lengths after any edit, which would wipe pretension).
 #pragma once
 
 #include <Eigen/Core>
@@ -34,6 +38,8 @@
 #include <vector>
 
 #include "conform/cga/plane.hpp"
+#include "conform/membrane/skin_material.hpp"
+#include "conform/membrane/solver.hpp"
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/skinned_mesh.hpp"
@@ -48,28 +54,42 @@ struct btSoftBodyWorldInfo;
 
 namespace conform::bullet {
 
+/// How a skinned soft body's skin resists deformation.
+enum class MaterialModel {
+  /// The skin membrane (core/membrane): pre-stressed St Venant-Kirchhoff triangles in SI units
+  /// attached to the skinned targets by the subcutaneous layer, solved each substep to a
+  /// residual (Material::skin, Material::solver). Mesh- and solver-independent; the default.
+  membrane,
+  /// Bullet's own mass-spring links (position-based, kLST per iteration): the fields from
+  /// link_stiffness to bending_stiffness below. Its stiffness depends on the iterations, the
+  /// substeps and the mesh; kept for comparison and for cloth-like uses.
+  bullet_links,
+};
+
 /// Physical parameters of a skinned soft body. Units are SI (metres, kilograms, seconds).
 struct Material {
-  /// Bullet's linear stiffness kLST, dimensionless in (0, 1]: the fraction of a link's length
-  /// error its position solver removes per iteration.
+  MaterialModel model = MaterialModel::membrane;
+  /// bullet_links: Bullet's linear stiffness kLST, dimensionless in (0, 1]: the fraction of a
+  /// link's length error its position solver removes per iteration.
   double link_stiffness = 0.9;
   /// Bullet's damping kDP, dimensionless in [0, 1): fraction of velocity removed per substep.
   double damping = 0.0;
   /// Pretension s, dimensionless in [0, 1): a link's rest length is (1 − s) × its length when
   /// the link is made (at creation, or when a topology change adds it).
   double pretension = 0.0;
-  /// Areal mass density, kg/m². Each node gets a third of the area of its faces times this
-  /// (skin about 1 mm thick ≈ 1.1 kg/m²).
+  /// bullet_links: areal mass density, kg/m². Each node gets a third of the area of its faces
+  /// times this (skin about 1 mm thick ≈ 1.1 kg/m²). The membrane uses skin.areal_density.
   double density = 1.1;
-  /// Pull of a free node toward its skinned target per metre of offset, 1/s² (the squared
-  /// angular frequency of the node's own spring). 0 leaves free nodes to the links alone.
+  /// bullet_links: pull of a free node toward its skinned target per metre of offset, 1/s² (the
+  /// squared angular frequency of the node's own spring). 0 leaves free nodes to the links alone.
   double target_stiffness = 400.0;
-  /// Damping of a free node's velocity relative to its target's velocity, 1/s.
+  /// bullet_links: damping of a free node's velocity relative to its target's velocity, 1/s.
   double target_damping = 20.0;
-  /// Nodes whose largest bone weight is ≥ this are kinematic; > 1 makes none kinematic by
-  /// weight (pinned vertices still are).
+  /// bullet_links: nodes whose largest bone weight is ≥ this are kinematic; > 1 makes none
+  /// kinematic by weight (pinned vertices still are). With the membrane only pinned vertices
+  /// are kinematic: the attachment makes every other node follow its target.
   double kinematic_weight = 0.999;
-  /// Bullet's position iterations per substep.
+  /// Bullet's position iterations per substep (its link solve and its contacts).
   int position_iterations = 4;
   /// Bending links: Bullet's linear stiffness kLST of a link joining the two vertices opposite
   /// each edge shared by exactly two faces, dimensionless in [0, 1]. 0 (default) makes none.
@@ -78,6 +98,10 @@ struct Material {
   double bending_stiffness = 0.0;
   /// Collision margin of the pieces, m.
   double margin = 0.005;
+  /// membrane: the skin's material (SI units, sourced defaults for human skin).
+  membrane::SkinMaterial skin;
+  /// membrane: the solve of each substep (tolerance in Pa of nodal traction).
+  membrane::SolverSettings solver;
 };
 
 /// What one applied TopologyChange did to the Bullet side.
@@ -191,6 +215,10 @@ class SkinnedSoftBody {
   /// and node_of() −1.
   bool detached(std::int32_t vertex) const;
   std::int32_t detached_count() const;
+
+  /// The membrane's solve of the last substep (residual in Pa, iterations); zero with
+  /// bullet_links.
+  const membrane::SolveReport& last_solve() const;
 
   /// One substep, called by the plugin's action: pose, skin, drive nodes, re-apply rest lengths.
   void update(double dt, double time);

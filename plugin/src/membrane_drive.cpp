@@ -1,0 +1,57 @@
+#include "membrane_drive.hpp"
+
+#include <BulletSoftBody/btSoftBody.h>
+
+namespace conform::bullet {
+
+void MembraneDrive::target_normals(const mesh::SkinnedMesh& mesh,
+                                   const Eigen::Ref<const Eigen::Matrix3Xd>& t) {
+  normals_.setZero(3, t.cols());
+  for (const mesh::Face& f : mesh.faces) {
+    const Eigen::Vector3d n = (t.col(f[1]) - t.col(f[0])).cross(t.col(f[2]) - t.col(f[0]));
+    for (const std::int32_t v : f) normals_.col(v) += n;  // area-weighted
+  }
+  for (Eigen::Index v = 0; v < normals_.cols(); ++v) {
+    const double length = normals_.col(v).norm();
+    if (length > 0) normals_.col(v) /= length;
+  }
+}
+
+membrane::SolveReport MembraneDrive::step(
+    const mesh::SkinnedMesh& mesh, const membrane::SkinMaterial& material,
+    const membrane::SolverSettings& settings, std::span<void* const> nodes,
+    std::span<const std::uint8_t> fixed, std::span<const double> masses,
+    const Eigen::Ref<const Eigen::Matrix3Xd>& targets,
+    const Eigen::Ref<const Eigen::Matrix3Xd>& previous_targets, double dt) {
+  const Eigen::Index nv = mesh.vertex_count();
+  if (stale_ || model_.vertex_count() != nv) {
+    model_.build(mesh.rest, mesh.faces, material);
+    stale_ = false;
+  }
+  x_.resize(3, nv);
+  start_.resize(3, nv);
+  velocity_ = (targets - previous_targets) / dt;
+  fixed_.assign(fixed.begin(), fixed.end());
+  for (Eigen::Index v = 0; v < nv; ++v) {
+    const auto* node = static_cast<const btSoftBody::Node*>(nodes[std::size_t(v)]);
+    if (!node) {  // outside Bullet: rides its target
+      x_.col(v) = start_.col(v) = targets.col(v);
+      fixed_[std::size_t(v)] = 1;
+      continue;
+    }
+    x_.col(v) = Eigen::Vector3d(node->m_x.x(), node->m_x.y(), node->m_x.z());
+    start_.col(v) = Eigen::Vector3d(node->m_q.x(), node->m_q.y(), node->m_q.z());
+  }
+  target_normals(mesh, targets);
+  const membrane::StepInput input{targets, normals_, start_, velocity_, fixed_, dt, masses};
+  report_ = solver_.solve(model_, input, settings, x_);
+  for (Eigen::Index v = 0; v < nv; ++v) {
+    if (fixed_[std::size_t(v)]) continue;
+    auto* node = static_cast<btSoftBody::Node*>(nodes[std::size_t(v)]);
+    node->m_x = btVector3(btScalar(x_(0, v)), btScalar(x_(1, v)), btScalar(x_(2, v)));
+    node->m_v = (node->m_x - node->m_q) / btScalar(dt);
+  }
+  return report_;
+}
+
+}  // namespace conform::bullet
