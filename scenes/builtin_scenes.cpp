@@ -10,6 +10,7 @@ namespace conform::scenes {
 const std::vector<SceneKind>& scene_kinds() {
   static const std::vector<SceneKind> kinds = {
       {"tear-opening", &make_tear_opening},
+      {"membrane-slit", &make_membrane_slit},
       {"arm-track", &make_arm_track},
       {"cut", &make_cut},
       {"drill", &make_drill},
@@ -45,6 +46,21 @@ const std::vector<BuiltinScene>& builtin_scenes() {
   "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
                "gravity": [0, -9.81, 0] },
   "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json"},
+      {"membrane-slit",
+       "the skin membrane against LEFM: a pinned, pre-stressed sheet slit through its centre "
+       "opens as an ellipse of maximum 4 sigma_n a / E",
+       R"json({
+  "scene": "membrane-slit",
+  "description": "A square sheet of skin membrane (SI units) pinned at its border and pre-stressed by material.prestress along its axes is slit through its centre by a topology change on the live Bullet soft body; it settles, and its opening is compared with linear elastic fracture mechanics (plane stress): w_max = 4 sigma_n a / E.",
+  "duration": 1.0,
+  "sheet": { "width": 0.8, "resolution": 0.0025, "tip_refinement": 16 },
+  "slit": { "length": 0.05, "angle_deg": 0, "at": 0.1 },
+  "material": { "prestress": [400, 400], "youngs_modulus": 420000, "poisson_ratio": 0.48,
+                "thickness": 0.0015, "attachment_stiffness": 0,
+                "attachment_normal_stiffness": 0, "tolerance": 0.4, "max_cg_iterations": 4000 },
+  "physics": { "dt": 0.016666666666666666, "substeps": 1, "gravity": [0, 0, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 0, "plots": true }
 })json"},
       {"arm-track",
        "btMultiBody arm driven by CGA IK along a figure-eight and random waypoints, skin by CGA "

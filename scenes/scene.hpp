@@ -37,6 +37,7 @@ struct SceneKind {
 
 std::unique_ptr<Scene> make_arm_track(const Json&, const std::string&, int);
 std::unique_ptr<Scene> make_tear_opening(const Json&, const std::string&, int);
+std::unique_ptr<Scene> make_membrane_slit(const Json&, const std::string&, int);
 std::unique_ptr<Scene> make_cut(const Json&, const std::string&, int);
 std::unique_ptr<Scene> make_drill(const Json&, const std::string&, int);
 std::unique_ptr<Scene> make_character(const Json&, const std::string&, int);

@@ -122,6 +122,24 @@ Eigen::Vector3d Reader::vec3(const std::string& key, const Eigen::Vector3d& fall
   return x;
 }
 
+std::array<double, 2> Reader::pair(const std::string& key, const std::array<double, 2>& fallback,
+                                   double min, double max) {
+  const Json* v = get(key);
+  std::array<double, 2> x = fallback;
+  if (v) {
+    if (!v->is_array() || v->size() != 2) fail(key, *v, "must be an array of 2 numbers");
+    for (std::size_t i = 0; i < 2; ++i) {
+      const Json& c = (*v)[i];
+      if (!c.is_number() || !std::isfinite(c.get<double>()))
+        fail(key, *v, "must be an array of 2 finite numbers");
+      x[i] = c.get<double>();
+      if (x[i] < min || x[i] > max) fail(key, *v, range_text(min, max));
+    }
+  }
+  (*resolved_)[key] = {x[0], x[1]};
+  return x;
+}
+
 Reader Reader::object(const std::string& key) {
   const Json* v = get(key);
   if (v && !v->is_object()) fail(key, *v, "must be a JSON object");

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <initializer_list>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -51,6 +52,9 @@ class Reader {
   std::string text(const std::string& key, const std::string& fallback,
                    std::initializer_list<const char*> allowed = {});
   Eigen::Vector3d vec3(const std::string& key, const Eigen::Vector3d& fallback);
+  /// An array of exactly two numbers, each in [min, max].
+  std::array<double, 2> pair(const std::string& key, const std::array<double, 2>& fallback,
+                             double min = -kInf, double max = kInf);
   /// A sub-object (an empty one when absent); it must be finished by the caller.
   Reader object(const std::string& key);
   /// An array of objects (empty when absent), each read through the callback.

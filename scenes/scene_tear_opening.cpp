@@ -1,14 +1,20 @@
 // `tear-opening`: the skinned arm under pretension is torn by a scalpel stroke along the
 // forearm; the same stroke is run twice on the same pose:
-//   physics    — a SkinnedSoftBody (Bullet soft body skinned by CGA, links pre-tensioned);
-//                the wound opens by itself because its links are shorter at rest than made;
+//   physics    — a SkinnedSoftBody (Bullet soft body skinned by CGA) whose skin is the
+//                pre-stressed membrane (Material::skin, SI units) attached to the skinned
+//                targets; the wound opens by itself because the skin is under tension
+//                (material.model = "bullet_links" runs Bullet's pre-tensioned links instead);
 //   geometric  — the same tear on the posed mesh alone (Algorithm 2), opened by step 6 (the
 //                borders moved apart by a prescribed sine taper once the stroke ends).
 // Measured over time: the gap-width profile along the tear, the largest opening and the opened
 // area; at the end an elliptical fit of the physical profile (a slit in a stretched membrane
-// opens as an ellipse).
+// opens as an ellipse). pose.flex_deg flexes the elbow after the stroke (the physical wound
+// follows the pose, the geometric one does not); tear.direction = "across" turns the incision
+// around the limb, across skin-tension lines given by material.prestress / prestress_axis.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <numbers>
 #include <sstream>
 
@@ -33,6 +39,12 @@ class TearOpening final : public Scene {
     Reader pose = root.object("pose");
     // The stroke is in world space: with a flexed elbow, move it with the forearm.
     elbow_deg_ = pose.number("elbow_deg", 0, 0, 150);
+    // After the stroke the elbow may flex: the physical wound follows the pose.
+    flex_deg_ = pose.number("flex_deg", 0, -150, 150);
+    flex_at_ = pose.number("flex_at", 1.5, 0, 1e5);
+    flex_duration_ = pose.number("flex_duration", 0.5, 1e-3, 1e5);
+    if (elbow_deg_ + flex_deg_ < 0 || elbow_deg_ + flex_deg_ > 150)
+      pose.fail("flex_deg", flex_deg_, "elbow_deg + flex_deg must stay in [0, 150]");
     pose.finish();
     bullet::Material d;
     d.pretension = 0.2;
@@ -48,6 +60,15 @@ class TearOpening final : public Scene {
     s.from = Vec3(0, 0.0023, 0.3712), s.to = Vec3(0, 0.0023, 0.4912);  // off the vertex columns
     s.blade_a = Vec3(0.09, 0, 0), s.blade_b = Vec3(0.005, 0, 0);       // crosses the +x wall only
     stroke_ = read_stroke(tear, s);
+    // "across": the same incision turned a quarter around the limb axis (circumferential),
+    // e.g. across the principal pre-stress of skin-tension lines.
+    across_ = tear.text("direction", "along", {"along", "across"}) == "across";
+    if (across_) {
+      const Vec3 centre = 0.5 * (stroke_.from + stroke_.to);
+      const double half = 0.5 * (stroke_.to - stroke_.from).norm();
+      stroke_.from = centre - half * Vec3::UnitY();
+      stroke_.to = centre + half * Vec3::UnitY();
+    }
     tear.finish();
     Reader geo = root.object("geometric");
     amount_ = geo.number("amount", 0.01, 0, 1);
@@ -85,7 +106,7 @@ class TearOpening final : public Scene {
     SoftWorld w(c);
     const auto t_build = Clock::now();
     bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(arm.mesh, arm.skeleton, material_);
-    body.set_pose(pose);
+    body.set_pose_source(flexing_pose(pose, mo.upper_arm));
     const double build_ms =
         std::chrono::duration<double, std::milli>(Clock::now() - t_build).count();
 
@@ -113,6 +134,8 @@ class TearOpening final : public Scene {
     Profile phys, geom;
     double max_phys = 0, max_geom = 0, tear_ms = 0, measure_ms = 0, physics_ms = 0;
     int tear_steps = 0;
+    double worst_residual = 0, before_flex = -1;
+    int unconverged = 0;
     const auto rest_of = [](const mesh::SkinnedMesh& m) {
       return [&m](std::int32_t v) { return Vec3(m.rest.col(v)); };
     };
@@ -123,6 +146,9 @@ class TearOpening final : public Scene {
       w.step();
       physics_ms += std::chrono::duration<double, std::milli>(Clock::now() - tp).count();
       const double t = step * c.dt;
+      worst_residual = std::max(worst_residual, body.last_solve().residual);
+      unconverged +=
+          material_.model == bullet::MaterialModel::membrane && !body.last_solve().converged;
       // Topology edits only between steps.
       const auto tt = Clock::now();
       while (next < stroke_.samples && stroke_.time(next) <= t + 1e-12) {
@@ -147,6 +173,7 @@ class TearOpening final : public Scene {
             geo_tear.left_border(), geo_tear.right_border(),
             [&](std::int32_t v) { return Vec3(geo.current.col(v)); }, rest_of(geo));
       max_phys = std::max(max_phys, phys.max);
+      if (t <= flex_at_ + 1e-12) before_flex = phys.max;
       max_geom = std::max(max_geom, geom.max);
       if (step % c.metrics_every == 0 || step == c.steps) {
         const double row[] = {t,
@@ -267,6 +294,16 @@ class TearOpening final : public Scene {
     metrics["physics"] = part(phys, max_phys, *pt);
     metrics["geometric"] = part(geom, max_geom, geo_tear);
     metrics["geometric"]["amount"] = amount_;
+    const membrane::SolveReport& solve = body.last_solve();
+    metrics["physics"]["residual"] = solve.residual;  // Pa, the last substep's
+    metrics["physics"]["residual_max"] = worst_residual;
+    metrics["physics"]["unconverged_substeps"] = unconverged;
+    metrics["physics"]["newton_iterations"] = solve.newton_iterations;
+    metrics["physics"]["cg_iterations"] = solve.cg_iterations;
+    metrics["physics"]["max_opening_before_flex"] = before_flex;
+    metrics["physics"]["material"] =
+        material_.model == bullet::MaterialModel::membrane ? "membrane" : "bullet_links";
+    metrics["tear_direction"] = across_ ? "across" : "along";
     metrics["pieces"] = body.piece_count();
     metrics["nodes"] = body.vertex_count();
     metrics["units"] = "metres, square metres; profile_r2 of w_max*sqrt(1-(2s-1)^2)";
@@ -282,8 +319,22 @@ class TearOpening final : public Scene {
   }
 
  private:
+  // The posed arm, its elbow flexing by flex_deg over flex_duration from flex_at (smoothstep).
+  std::function<void(double, skin::Pose&)> flexing_pose(const skin::Pose& start,
+                                                        double upper_arm) const {
+    return [=, this](double time, skin::Pose& out) {
+      out = start;
+      const double u = std::clamp((time - flex_at_) / flex_duration_, 0.0, 1.0);
+      const double deg = elbow_deg_ + flex_deg_ * u * u * (3 - 2 * u);
+      out.set_local(
+          1, Eigen::Quaterniond(Eigen::AngleAxisd(deg * std::numbers::pi / 180, Vec3::UnitX())),
+          Vec3(0, 0, upper_arm));
+    };
+  }
+
   int resolution_ = 1;
-  double elbow_deg_ = 0;
+  double elbow_deg_ = 0, flex_deg_ = 0, flex_at_ = 1.5, flex_duration_ = 0.5;
+  bool across_ = false;
   bullet::Material material_;
   Stroke stroke_;
   double amount_ = 0.01;

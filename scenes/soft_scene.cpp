@@ -14,9 +14,38 @@ SoftWorld::SoftWorld(const CommonSettings& c) : dt(c.dt / c.substeps), substeps(
   plugin = std::make_unique<bullet::Plugin>(world);
 }
 
+// The membrane's fields (SI units; skin_material.hpp has their ranges and sources).
+void read_skin(Reader& r, const bullet::Material& d, bullet::Material& m) {
+  membrane::SkinMaterial& k = m.skin;
+  const membrane::SkinMaterial& e = d.skin;
+  k.youngs_modulus = r.number("youngs_modulus", e.youngs_modulus, 1, 1e10);
+  k.poisson_ratio = r.number("poisson_ratio", e.poisson_ratio, 0, 0.4999);
+  k.thickness = r.number("thickness", e.thickness, 1e-6, 1);
+  k.areal_density = r.number("areal_density", e.areal_density, 1e-6, 1e4);
+  k.prestress = r.pair("prestress", e.prestress, 0, 0.5 * k.youngs_modulus);
+  k.prestress_axis = r.vec3("prestress_axis", e.prestress_axis);
+  if (!(k.prestress_axis.norm() > 0))
+    r.fail("prestress_axis", Json::array({0, 0, 0}), "must be a non-zero direction");
+  k.attachment_stiffness = r.number("attachment_stiffness", e.attachment_stiffness, 0, 1e12);
+  k.attachment_normal_stiffness =
+      r.number("attachment_normal_stiffness", e.attachment_normal_stiffness, 0, 1e12);
+  k.attachment_damping = r.number("attachment_damping", e.attachment_damping, 0, 1e9);
+  m.solver.tolerance = r.number("tolerance", d.solver.tolerance, 1e-9, 1e9);
+  m.solver.max_newton_iterations =
+      r.integer("max_newton_iterations", d.solver.max_newton_iterations, 1, 10000);
+  m.solver.max_cg_iterations =
+      r.integer("max_cg_iterations", d.solver.max_cg_iterations, 1, 1000000);
+}
+
 bullet::Material read_material(Reader& root, const bullet::Material& d) {
   Reader r = root.object("material");
   bullet::Material m;
+  const std::string model =
+      r.text("model", d.model == bullet::MaterialModel::membrane ? "membrane" : "bullet_links",
+             {"membrane", "bullet_links"});
+  m.model =
+      model == "membrane" ? bullet::MaterialModel::membrane : bullet::MaterialModel::bullet_links;
+  read_skin(r, d, m);
   m.link_stiffness = r.number("link_stiffness", d.link_stiffness, 1e-4, 1);
   m.damping = r.number("damping", d.damping, 0, 0.999);
   m.pretension = r.number("pretension", d.pretension, 0, 0.9);

@@ -30,20 +30,27 @@ membrane::SolveReport MembraneDrive::step(
   }
   x_.resize(3, nv);
   start_.resize(3, nv);
+  predicted_.resize(3, nv);
   velocity_ = (targets - previous_targets) / dt;
   fixed_.assign(fixed.begin(), fixed.end());
   for (Eigen::Index v = 0; v < nv; ++v) {
     const auto* node = static_cast<const btSoftBody::Node*>(nodes[std::size_t(v)]);
     if (!node) {  // outside Bullet: rides its target
-      x_.col(v) = start_.col(v) = targets.col(v);
+      x_.col(v) = start_.col(v) = predicted_.col(v) = targets.col(v);
       fixed_[std::size_t(v)] = 1;
       continue;
     }
-    x_.col(v) = Eigen::Vector3d(node->m_x.x(), node->m_x.y(), node->m_x.z());
+    predicted_.col(v) = Eigen::Vector3d(node->m_x.x(), node->m_x.y(), node->m_x.z());
     start_.col(v) = Eigen::Vector3d(node->m_q.x(), node->m_q.y(), node->m_q.z());
+    // Initial guess: the last solution carried along by its target; near the equilibrium
+    // (where it balances gravity and the membrane) this is within the tolerance already,
+    // while Bullet's prediction (+ g dt^2) is not.
+    x_.col(v) = fixed_[std::size_t(v)] ? predicted_.col(v)
+                                       : Eigen::Vector3d(start_.col(v) + dt * velocity_.col(v));
   }
   target_normals(mesh, targets);
-  const membrane::StepInput input{targets, normals_, start_, velocity_, fixed_, dt, masses};
+  const membrane::StepInput input{targets, normals_, start_,     velocity_,
+                                  fixed_,  dt,       predicted_, masses};
   report_ = solver_.solve(model_, input, settings, x_);
   for (Eigen::Index v = 0; v < nv; ++v) {
     if (fixed_[std::size_t(v)]) continue;

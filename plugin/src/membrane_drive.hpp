@@ -43,7 +43,7 @@ class MembraneDrive {
   membrane::Solver solver_;
   membrane::SolveReport report_;
   bool stale_ = true;
-  Eigen::Matrix3Xd x_, start_, velocity_, normals_;
+  Eigen::Matrix3Xd x_, start_, predicted_, velocity_, normals_;
   std::vector<std::uint8_t> fixed_;
 };
 

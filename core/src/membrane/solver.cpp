@@ -74,7 +74,8 @@ void prepare_nodes(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
   const SkinMaterial& m = c.model.material();
   s.node_stiffness_.resize(static_cast<std::size_t>(c.nv));
   s.inertia_weight_.setZero(c.nv);
-  s.predicted_ = x;
+  s.predicted_ =
+      c.in.predicted.cols() == c.nv ? Eigen::Matrix3Xd(c.in.predicted) : Eigen::Matrix3Xd(x);
   const bool normals = c.in.target_normals.cols() == c.nv;
   for (std::int64_t v = 0; v < c.nv; ++v) {
     const double area = c.model.node_area(std::int32_t(v));
@@ -264,6 +265,7 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
   require_cols(x, nv, false, "x");
   require_cols(input.targets, nv, false, "targets");
   require_cols(input.target_normals, nv, true, "target_normals");
+  require_cols(input.predicted, nv, true, "predicted");
   if (input.fixed.size() != static_cast<std::size_t>(nv))
     throw std::invalid_argument("membrane solve: fixed has " + std::to_string(input.fixed.size()) +
                                 " entries, the model has " + std::to_string(nv) + " vertices");

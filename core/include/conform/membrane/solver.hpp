@@ -50,6 +50,10 @@ struct StepInput {
   std::span<const std::uint8_t> fixed;
   /// Step, s; <= 0 for the static equilibrium.
   double dt = 0;
+  /// The predicted positions xp of the inertia term (3 x #V), or empty: x's given values are
+  /// the prediction. A host that knows a better initial guess than the prediction (e.g. the last
+  /// solution moved with the targets) passes the prediction here and its guess in x.
+  Eigen::Ref<const Eigen::Matrix3Xd> predicted = Eigen::Matrix3Xd(3, 0);
   /// Node masses, kg (empty: rho_A times the node's rest area). A host whose edits split and
   /// conserve mass (the Bullet plugin) passes its own books, so inertia and momentum agree.
   std::span<const double> masses = {};
@@ -70,7 +74,8 @@ class Solver {
   Solver(Solver&&) noexcept;
   Solver& operator=(Solver&&) noexcept;
 
-  /// x: in, the predicted positions xp (the initial guess; fixed nodes' values are kept);
+  /// x: in, the initial guess (and the prediction xp unless StepInput::predicted is given;
+  /// fixed nodes' values are kept);
   /// out, the solution. Throws std::invalid_argument on mismatched shapes.
   SolveReport solve(const Model& model, const StepInput& input, const SolverSettings& settings,
                     Eigen::Ref<Eigen::Matrix3Xd> x);

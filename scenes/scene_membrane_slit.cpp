@@ -1,0 +1,175 @@
+// `membrane-slit`: the skin membrane against linear elastic fracture mechanics. A flat sheet,
+// pinned at its border and pre-stressed by material.prestress = [sigma_xx, sigma_yy] along its
+// axes, is slit through its centre (a TopologyChange applied to the live Bullet soft body) and
+// settles; LEFM (plane stress) gives an elliptic opening of maximum 4 sigma_n a / E, sigma_n the
+// pre-stress normal to the slit (slit_sheet.hpp). Reports w_max, the profile's R^2 against the
+// ellipse, the LEFM value and the membrane solver's residual.
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+#include "conform/membrane/slit_sheet.hpp"
+#include "conform/skin/skeleton.hpp"
+#include "scene.hpp"
+#include "soft_scene.hpp"
+
+namespace conform::scenes {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+skin::Skeleton one_bone() {
+  skin::Skeleton s;
+  s.joints.push_back({"root", -1, skin::Versor::identity()});
+  s.bones.push_back({"root", 0, skin::Versor::identity()});
+  return s;
+}
+
+class MembraneSlit final : public Scene {
+ public:
+  MembraneSlit(const Json& scene, const std::string& name, int steps_override) {
+    Reader root(scene, "", resolved_);
+    Reader sheet = root.object("sheet");
+    options_.width = sheet.number("width", 0.8, 1e-3, 100);
+    options_.element_size = sheet.number("resolution", 2.5e-3, 1e-5, 1);
+    options_.tip_refinement = sheet.number("tip_refinement", 16, 1, 64);
+    sheet.finish();
+    Reader slit = root.object("slit");
+    options_.slit_length = slit.number("length", 0.05, 1e-4, 10);
+    options_.slit_angle = slit.number("angle_deg", 0, -360, 360) * std::numbers::pi / 180;
+    at_ = slit.number("at", 0.1, 0, 1e5);
+    slit.finish();
+    bullet::Material d;
+    d.skin.prestress = {400, 400};
+    d.skin.attachment_stiffness = 0;  // a free membrane held by its border
+    d.skin.attachment_normal_stiffness = 0;
+    d.solver.tolerance = 0.4;
+    d.solver.max_cg_iterations = 4000;
+    material_ = read_material(root, d);
+    common_ = read_common(root, name, 1.0, steps_override);
+    root.finish();
+    try {
+      options_.validate();
+    } catch (const std::invalid_argument& e) {
+      throw SceneError("sheet", "", e.what());
+    }
+    if (material_.model != bullet::MaterialModel::membrane)
+      throw SceneError("material.model", "\"bullet_links\"",
+                       "membrane-slit measures the membrane; Bullet's links have no modulus");
+  }
+
+  Json run(RunOutput& out) override {
+    const CommonSettings& c = common_;
+    const membrane::SlitSheet sheet = membrane::make_slit_sheet(options_);
+    SoftWorld w(c);
+    bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(sheet.mesh, one_bone(), material_);
+    std::vector<std::int32_t> border;
+    for (std::size_t v = 0; v < sheet.border.size(); ++v)
+      if (sheet.border[v]) border.push_back(std::int32_t(v));
+    body.set_pinned(border);
+    out.open_metrics({"t", "w_max", "residual", "newton_iterations", "cg_iterations"});
+    const double a = 0.5 * options_.slit_length;
+    const auto measure = [&] {
+      Eigen::Matrix3Xd x(3, body.vertex_count());
+      for (std::int32_t v = 0; v < body.vertex_count(); ++v) x.col(v) = body.position(v);
+      return membrane::slit_opening(sheet, x);
+    };
+    bool slit = false;
+    double physics_ms = 0, worst_after = 0;
+    std::vector<double> w_now;
+    out.frame("sheet", 0, body.mesh());
+    const auto loop_start = Clock::now();
+    for (int step = 1; step <= c.steps; ++step) {
+      const double t = step * c.dt;
+      const auto tp = Clock::now();
+      w.step();
+      physics_ms += std::chrono::duration<double, std::milli>(Clock::now() - tp).count();
+      if (!slit && t >= at_) {  // between steps: the slit, as a topology change
+        body.sync_mesh();
+        body.apply(sheet.slit);
+        slit = true;
+      }
+      const membrane::SolveReport& r = body.last_solve();
+      if (slit) w_now = measure();
+      const double w_max = w_now.empty() ? 0.0 : membrane::fit_ellipse(sheet.lip_s, w_now, a).w_max;
+      if (step % c.metrics_every == 0 || step == c.steps) {
+        const double row[] = {t, w_max, r.residual, double(r.newton_iterations),
+                              double(r.cg_iterations)};
+        out.metrics().row(row);
+      }
+      if (slit && step == c.steps) {
+        worst_after = r.residual;
+        body_converged_ = r.converged;
+      }
+      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
+        body.sync_mesh();
+        out.frame("sheet", step, body.mesh());
+      }
+      out.progress(step, c.steps);
+    }
+    const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
+    if (!slit)
+      throw std::runtime_error("membrane-slit: the run ended (" + std::to_string(c.steps * c.dt) +
+                               " s) before slit.at = " + std::to_string(at_) + " s");
+    return summarise(out, sheet, w_now, worst_after, physics_ms, loop_s);
+  }
+
+ private:
+  Json summarise(RunOutput& out, const membrane::SlitSheet& sheet, const std::vector<double>& w,
+                 double residual, double physics_ms, double loop_s) {
+    const CommonSettings& c = common_;
+    const double a = 0.5 * options_.slit_length;
+    const double sigma_n =
+        membrane::normal_prestress(sheet, material_.skin.prestress[0], material_.skin.prestress[1]);
+    const double lefm = 4 * sigma_n * a / material_.skin.youngs_modulus;
+    const membrane::EllipseFit fit = membrane::fit_ellipse(sheet.lip_s, w, a);
+    {
+      RunOutput::Csv profile = out.open_csv("profile.csv", {"s", "width", "lefm_width"});
+      for (std::size_t i = 0; i < w.size(); ++i) {
+        const double u = sheet.lip_s[i] / a;
+        const double row[] = {sheet.lip_s[i], w[i], lefm * std::sqrt(std::max(0.0, 1 - u * u))};
+        profile.row(row);
+      }
+    }
+    out.add_plot({"profile",
+                  "membrane-slit: opening along the slit against LEFM",
+                  "position along the slit [m]",
+                  "opening [m]",
+                  {{"profile.csv", "s", "width", "membrane (Bullet nodes)", "linespoints"},
+                   {"profile.csv", "s", "lefm_width", "LEFM 4 sigma_n a / E", "lines"}},
+                  {}});
+    out.add_plot({"convergence",
+                  "membrane-slit: largest opening over time",
+                  "time [s]",
+                  "largest opening [m]",
+                  {{"metrics.csv", "t", "w_max", "w_max", "lines"}},
+                  {}});
+    Json metrics = {{"w_max", fit.w_max},
+                    {"profile_r2", fit.r2},
+                    {"lefm_w_max", lefm},
+                    {"w_max_over_lefm", lefm > 0 ? fit.w_max / lefm : 0.0},
+                    {"sigma_n", sigma_n},
+                    {"residual", residual},
+                    {"converged", body_converged_},
+                    {"nodes", sheet.mesh.vertex_count() + int(sheet.slit.new_vertices.size())},
+                    {"faces", sheet.mesh.face_count()},
+                    {"units", "metres, pascals; residual: largest nodal force per node area, Pa"}};
+    Json timings = {{"physics_ms_per_step", physics_ms / c.steps}};
+    out.finish(resolved_, metrics, timings, c.steps, c.steps * c.dt, loop_s);
+    return metrics;
+  }
+
+  membrane::SlitSheetOptions options_;
+  bullet::Material material_;
+  double at_ = 0.1;
+  bool body_converged_ = true;
+};
+
+}  // namespace
+
+std::unique_ptr<Scene> make_membrane_slit(const Json& scene, const std::string& name,
+                                          int steps_override) {
+  return std::make_unique<MembraneSlit>(scene, name, steps_override);
+}
+
+}  // namespace conform::scenes
