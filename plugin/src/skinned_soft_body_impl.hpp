@@ -92,6 +92,7 @@ struct SkinnedSoftBody::Impl {
     return piece_of_[static_cast<std::size_t>(vertex)] < 0;
   }
   std::int32_t detached_count() const { return detached_count_; }
+  bool is_kinematic_by_weight(std::int32_t vertex) const;
 
   // --- Skin drive (skin_drive.cpp): update() is the one per-substep entry point ---
   void update(double dt, double time);
@@ -112,7 +113,6 @@ struct SkinnedSoftBody::Impl {
   void place_faces_and_links(const mesh::SkinnedMesh& mesh);
   void drop_empty_pieces();
   void detach(std::int32_t vertex);
-  bool is_kinematic_by_weight(std::int32_t vertex) const;
   /// Moves a whole connected piece (its vertices in Bullet) into a new body, with room for
   /// `joining` nodes and `added_faces` faces still to come in this change; the body's index.
   std::int32_t move_to_new_piece(std::span<const std::int32_t> moving, std::int32_t joining,
