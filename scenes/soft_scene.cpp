@@ -6,10 +6,8 @@
 
 namespace conform::scenes {
 
-SoftWorld::SoftWorld(const CommonSettings& c) : dt(c.dt / c.substeps), substeps(c.substeps) {
-  world.setGravity(bullet::to_bt(c.gravity));
-  world.getWorldInfo().m_gravity = bullet::to_bt(c.gravity);
-  world.getWorldInfo().m_sparsesdf.Initialize();
+SoftWorld::SoftWorld(const CommonSettings& c)
+    : bullet::SoftWorld(bullet::to_bt(c.gravity)), dt(c.dt / c.substeps), substeps(c.substeps) {
   world.getSolverInfo().m_numIterations = c.solver_iterations;
   plugin = std::make_unique<bullet::Plugin>(world);
 }

@@ -3,27 +3,19 @@
 // file, scalpel paths, the arm's pose and tear-profile measurements.
 #pragma once
 
-#include <BulletSoftBody/btDefaultSoftBodySolver.h>
-#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
-#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
-#include <btBulletDynamicsCommon.h>
-
 #include <memory>
 #include <vector>
 
 #include "conform/bullet/plugin.hpp"
+#include "conform/bullet/soft_world.hpp"
 #include "conform/mesh/tear.hpp"
 #include "run_output.hpp"
 
 namespace conform::scenes {
 
-struct SoftWorld {
-  btSoftBodyRigidBodyCollisionConfiguration config;
-  btCollisionDispatcher dispatcher{&config};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDefaultSoftBodySolver soft_solver;
-  btSoftRigidDynamicsWorld world{&dispatcher, &broadphase, &solver, &config, &soft_solver};
+/// The plugin's soft world (conform/bullet/soft_world.hpp) with the scene's settings and the
+/// Conform plugin attached.
+struct SoftWorld : bullet::SoftWorld {
   std::unique_ptr<bullet::Plugin> plugin;
   double dt = 1.0 / 60;
   int substeps = 1;
@@ -31,7 +23,7 @@ struct SoftWorld {
   explicit SoftWorld(const CommonSettings& c);
   ~SoftWorld() { plugin.reset(); }  // the plugin's bodies leave the world first
   /// One step of c.dt in c.substeps fixed substeps.
-  void step() { world.stepSimulation(btScalar(dt * substeps), substeps, btScalar(dt)); }
+  void step() { bullet::SoftWorld::step(dt, substeps); }
 };
 
 /// Reads the "material" object (every key of bullet::Material), with scene-specific defaults.

@@ -1,11 +1,6 @@
 // A real Bullet soft-rigid world for the plugin tests (no gravity unless asked).
 #pragma once
 
-#include <BulletSoftBody/btDefaultSoftBodySolver.h>
-#include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
-#include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
-#include <btBulletDynamicsCommon.h>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -15,25 +10,18 @@
 #include <vector>
 
 #include "conform/bullet/skinned_soft_body.hpp"
+#include "conform/bullet/soft_world.hpp"
 #include "conform/mesh/primitives.hpp"
 #include "conform/skin/pose.hpp"
 
 namespace conform::test {
 
-struct SoftWorld {
-  btSoftBodyRigidBodyCollisionConfiguration config;
-  btCollisionDispatcher dispatcher{&config};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  btDefaultSoftBodySolver soft_solver;
-  btSoftRigidDynamicsWorld world{&dispatcher, &broadphase, &solver, &config, &soft_solver};
-  explicit SoftWorld(double gravity = 0) {
-    world.setGravity(btVector3(0, 0, btScalar(-gravity)));
-    world.getWorldInfo().m_gravity = btVector3(0, 0, btScalar(-gravity));
-    world.getWorldInfo().m_sparsesdf.Initialize();
-  }
+/// The plugin's soft world with the tests' defaults: gravity g along −z (none unless asked),
+/// and steps of one 1/60 s substep.
+struct SoftWorld : bullet::SoftWorld {
+  explicit SoftWorld(double gravity = 0) : bullet::SoftWorld(btVector3(0, 0, btScalar(-gravity))) {}
   void step(int n = 1, double dt = 1.0 / 60) {
-    for (int i = 0; i < n; ++i) world.stepSimulation(btScalar(dt), 1, btScalar(dt));
+    for (int i = 0; i < n; ++i) bullet::SoftWorld::step(dt);
   }
 };
 

@@ -1,6 +1,11 @@
 // SkinnedSoftBody's private side: the books mirroring the mesh into Bullet (per vertex, per
-// face, per edge), the skinning buffers and the scratch of topology changes. The public class
-// forwards to it (skinned_soft_body.hpp describes the behaviour).
+// face, per edge), the skin drive and the scratch of topology changes. The public class
+// forwards to it (skinned_soft_body.hpp describes the behaviour). Its members live by concept:
+//   skinned_soft_body.cpp  facade: construction, edit entry points, queries, forwarders;
+//   skin_drive.cpp         pose source, skinned targets, the per-substep update;
+//   bullet_surgery.cpp     add/remove of nodes, faces and links, link constants, node areas;
+//   piece_books.cpp        bodies per piece, moving a piece, detaching, kept rest lengths;
+//   topology_mirror.cpp    a TopologyChange into Bullet, in phases over a MirrorContext.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,11 +19,17 @@
 
 #include "conform/bullet/skinned_soft_body.hpp"
 #include "conform/mesh/adjacency.hpp"
+#include "conform/mesh/analysis.hpp"
 #include "conform/mesh/face_index.hpp"
-#include "conform/skin/skinning.hpp"
+#include "conform/mesh/split_search.hpp"
 #include "membrane_drive.hpp"
+#include "skin_drive.hpp"
+
+struct btDbvtNode;
 
 namespace conform::bullet {
+
+struct MirrorContext;
 
 struct SkinnedSoftBody::Impl {
   // The public methods, documented in skinned_soft_body.hpp.
@@ -30,12 +41,18 @@ struct SkinnedSoftBody::Impl {
   Impl& operator=(const Impl&) = delete;
 
   // --- Pose sources (the last one set wins). Time is the plugin's simulated time, s. ---
-  void set_pose(const skin::Pose& pose);
+  void set_pose(const skin::Pose& pose) { drive_.set_pose(pose); }
   void play(const skin::Animation& animation, skin::Blend blend = skin::Blend::linear,
-            bool loop = true);
-  void set_keyframes(skin::PoseTrack track, skin::Blend blend = skin::Blend::linear);
-  void set_pose_source(std::function<void(double time, skin::Pose& pose)> source);
-  void set_skin_threads(int threads) { skin_threads_ = threads; }
+            bool loop = true) {
+    drive_.play(animation, blend, loop);
+  }
+  void set_keyframes(skin::PoseTrack track, skin::Blend blend = skin::Blend::linear) {
+    drive_.set_keyframes(std::move(track), blend);
+  }
+  void set_pose_source(std::function<void(double time, skin::Pose& pose)> source) {
+    drive_.set_pose_source(std::move(source));
+  }
+  void set_skin_threads(int threads) { drive_.set_threads(threads); }
   void set_pinned(std::span<const std::int32_t> vertices);
 
   // --- Topology changes: on the simulated positions, only between stepSimulation calls. ---
@@ -55,16 +72,16 @@ struct SkinnedSoftBody::Impl {
   std::int32_t vertex_count() const { return mesh_.vertex_count(); }
   std::int32_t piece_count() const;
   std::vector<btSoftBody*> pieces() const;
-  Eigen::Vector3d position(std::int32_t vertex) const;
-  Eigen::Vector3d velocity(std::int32_t vertex) const;
+  inline Eigen::Vector3d position(std::int32_t vertex) const;  // piece_books.hpp
+  inline Eigen::Vector3d velocity(std::int32_t vertex) const;
   double mass(std::int32_t vertex) const { return mass_[static_cast<std::size_t>(vertex)]; }
   bool kinematic(std::int32_t vertex) const { return kinematic_[static_cast<std::size_t>(vertex)]; }
-  btSoftBody* body_of(std::int32_t vertex) const;
+  inline btSoftBody* body_of(std::int32_t vertex) const;
   std::int32_t vertex_of(const btSoftBody* body, int node) const;
   std::int32_t node_of(std::int32_t vertex) const {
     return node_of_[static_cast<std::size_t>(vertex)];
   }
-  Eigen::Vector3d target(std::int32_t vertex) const;
+  Eigen::Vector3d target(std::int32_t vertex) const { return drive_.target(vertex); }
   double total_mass() const;
   Eigen::Vector3d momentum() const;
   double momentum_scale() const;
@@ -76,41 +93,80 @@ struct SkinnedSoftBody::Impl {
     return piece_of_[static_cast<std::size_t>(vertex)] < 0;
   }
   std::int32_t detached_count() const { return detached_count_; }
+  bool is_kinematic_by_weight(std::int32_t vertex) const;
 
+  // --- Skin drive (skin_drive.cpp): update() is the one per-substep entry point ---
   void update(double dt, double time);
   void skin_targets(double time);
+  struct Piece;  // piece_books.hpp
+  void drive_nodes(Piece& piece, double dt);
+  // The membrane (Material::model == membrane) replaces drive_nodes and the rest lengths.
+  bool membrane_model() const { return material_.model == MaterialModel::membrane; }
+  void step_membrane(double dt);
+  void reapply_rest_lengths(Piece& piece);
 
-  // --- Details ---
-  struct Piece;
-  void pose_at(double time, skin::Pose& pose);
+  // --- Piece books (piece_books.cpp) ---
+  struct PieceMove;  // piece_books.hpp
   Piece& new_piece();
   void build(const mesh::SkinnedMesh& mesh);
-  void mirror(const mesh::TopologyChange& change);
-  void rebuild_skin_inputs();
-  void set_node_mass(std::int32_t vertex);
-  /// `near`: a vertex next to it whose tree leaf it joins (−1: Bullet's own insert).
-  void add_node(std::int32_t piece, std::int32_t vertex, const Eigen::Vector3d& x,
-                const Eigen::Vector3d& v, std::int32_t near = -1);
-  void add_face(std::int32_t piece, std::int32_t face);
-  void remove_face_from_bullet(std::int32_t face);
-  void remove_face_slot(std::int32_t face);  // out of its body only (no links, no stats)
-  void remove_nodes_highest_first(std::span<const std::int32_t> vertices);
+  void reserve_books(const mesh::SkinnedMesh& mesh);
+  void index_faces(const mesh::SkinnedMesh& mesh);
+  std::vector<std::int32_t> make_bodies(const mesh::Pieces& labels);
+  void place_nodes(const mesh::SkinnedMesh& mesh, const mesh::Pieces& labels,
+                   std::span<const std::int32_t> body_of_piece);
+  void place_faces_and_links(const mesh::SkinnedMesh& mesh);
+  void drop_empty_pieces();
+  void detach(std::int32_t vertex);
   /// Moves a whole connected piece (its vertices in Bullet) into a new body, with room for
   /// `joining` nodes and `added_faces` faces still to come in this change; the body's index.
   std::int32_t move_to_new_piece(std::span<const std::int32_t> moving, std::int32_t joining,
                                  std::int32_t added_faces);
+  void gather_move(PieceMove& move);
+  void mark_moving_links(PieceMove& move);
+  void open_new_body(PieceMove& move, std::int32_t joining, std::int32_t added_faces);
+  void copy_moving_nodes(PieceMove& move);
+  void move_faces(PieceMove& move);
+  void move_links(PieceMove& move);
+  std::vector<btDbvtNode*> leave_old_bodies(PieceMove& move);
+  // Links removed during one change whose link may come back keep their rest length.
+  void keep_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d, double rest,
+                 bool bending);
+  double kept_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
+                   bool bending) const;
+  void clear_kept();
+  void refresh_bending(std::int32_t a, std::int32_t b);
+
+  // --- Bullet surgery (bullet_surgery.cpp) ---
+  void set_node_mass(std::int32_t vertex);
+  /// `near`: a vertex next to it whose tree leaf it joins (−1: Bullet's own insert).
+  void add_node(std::int32_t piece, std::int32_t vertex, const Eigen::Vector3d& x,
+                const Eigen::Vector3d& v, std::int32_t near = -1);
+  void remove_node(std::int32_t vertex);
+  void remove_nodes_highest_first(std::span<const std::int32_t> vertices);
+  void add_face(std::int32_t piece, std::int32_t face);
+  void remove_face_from_bullet(std::int32_t face);
+  void remove_face_slot(std::int32_t face);  // out of its body only (no links, no stats)
+  void add_link(std::int32_t piece, std::int32_t u, std::int32_t v, double rest);
   void remove_link(std::int32_t piece, std::int32_t link);
   void pop_link(std::int32_t piece, std::int32_t link);  // out of Bullet, key kept
-  void add_link(std::int32_t piece, std::int32_t u, std::int32_t v, double rest);
   void add_bending(std::int32_t piece, std::int32_t a, std::int32_t b, std::int32_t c,
                    std::int32_t d, double rest);
   void remove_bending(std::int32_t a, std::int32_t b);
-  void refresh_bending(std::int32_t a, std::int32_t b);
-  void remove_node(std::int32_t vertex);
-  void detach(std::int32_t vertex);
   void update_link_constants(std::int32_t vertex);
   void update_node_area(std::int32_t vertex);
-  bool is_kinematic_by_weight(std::int32_t vertex) const;
+
+  // --- Topology mirror (topology_mirror.cpp): its phases, in order ---
+  void mirror(const mesh::TopologyChange& change);
+  void make_new_vertices(MirrorContext& c);
+  void remove_faces(MirrorContext& c);
+  void assign_face_slots(MirrorContext& c);
+  void find_pieces(MirrorContext& c);
+  void move_pieces(MirrorContext& c);
+  void move_into_body(MirrorContext& c, std::span<const std::int32_t> moving, std::int32_t into);
+  void place_changed_nodes(MirrorContext& c);
+  void insert_faces_and_links(MirrorContext& c);
+  void refresh_changed_bending();
+  void refresh_changed_areas(MirrorContext& c);
 
   btSoftBodyWorldInfo* info_;
   std::function<void(btSoftBody*)> add_, remove_;
@@ -122,18 +178,10 @@ struct SkinnedSoftBody::Impl {
   skin::Skeleton skeleton_;
   Material material_;
   std::unique_ptr<mesh::Tear> tear_;
-
-  // Pose source.
-  std::function<void(double, skin::Pose&)> source_;
-  skin::Pose pose_;
-  std::vector<skin::Versor> global_, versors_;
-  std::vector<skin::Kernel34<double>> kernels_;
-  // Skinning inputs/outputs, SoA (see skinning.hpp), rebuilt when vertices are added.
-  skin::SoaPoints<double> rest_soa_, target_, previous_target_;
-  std::vector<std::int32_t> soa_bones_;
-  std::vector<double> soa_weights_;
-  bool fill_previous_ = false;
-  int skin_threads_ = 1;
+  SkinDrive drive_;  // after skeleton_, which it reads
+  MembraneDrive membrane_;
+  std::vector<void*> vertex_node_;  // per vertex: its btSoftBody::Node (null when detached)
+  Eigen::Matrix3Xd target_matrix_, previous_matrix_;
 
   // Per vertex.
   std::vector<std::int32_t> piece_of_, node_of_;
@@ -152,29 +200,16 @@ struct SkinnedSoftBody::Impl {
   std::vector<std::int32_t> detached_slot_;    // per vertex, −1 unless detached
   std::vector<std::int32_t> detached_vertex_;  // per slot
   std::int32_t detached_count_ = 0;
-  // Split search scratch (per vertex, −1 between searches).
-  std::vector<std::int32_t> search_label_;
-  std::vector<std::int32_t> seed_slot_;  // per vertex: its index among a change's seeds (−1)
+  // The split search of a change (its per-vertex labels stay allocated between changes).
+  mesh::SplitSearch split_;
   std::vector<std::int32_t> move_slot_;  // per vertex: its node in a new body (−1 between)
   // Links removed during one change whose link may come back: (a, b, c, d, rest), where (a, b)
   // is the key edge and (c, d) the end vertices (equal to (a, b) for an edge link).
   std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, double>> relink_;
-  mesh::EdgeMap relink_edge_, relink_bend_;  // key edge → index in relink_
-  void keep_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d, double rest,
-                 bool bending);
-  double kept_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
-                   bool bending) const;
-  void clear_kept();
+  mesh::EdgeMap relink_edge_, relink_bend_;          // key edge → index in relink_
   std::vector<std::uint8_t> area_mark_, seed_mark_;  // per vertex scratch, 0 between changes
   // Edges whose bending link may have to be made again at the end of a change.
   std::vector<std::pair<std::int32_t, std::int32_t>> bend_dirty_;
-
-  // The membrane (Material::model == membrane) and its per-substep inputs.
-  bool membrane_model() const { return material_.model == MaterialModel::membrane; }
-  void step_membrane(double dt);
-  MembraneDrive membrane_;
-  std::vector<void*> vertex_node_;
-  Eigen::Matrix3Xd target_matrix_, previous_matrix_;
 
   std::vector<std::unique_ptr<Piece>> pieces_;  // null once emptied
   ApplyStats stats_;

@@ -1,0 +1,78 @@
+// The piece books: one Bullet body per connected piece of the mesh, and for each the mesh
+// vertex, face and edge that its nodes, faces and links mirror. Also the small keys every part
+// of the plugin uses (an undirected edge, the third vertex of a face).
+#pragma once
+
+#include <BulletSoftBody/btSoftBody.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <new>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "conform/bullet/convert.hpp"
+#include "skinned_soft_body_impl.hpp"
+
+namespace conform::bullet {
+
+/// An undirected edge as the books key it: (min, max).
+inline std::pair<std::int32_t, std::int32_t> edge_key(std::int32_t a, std::int32_t b) {
+  return a < b ? std::pair{a, b} : std::pair{b, a};
+}
+
+/// The vertex of `f` that is neither a nor b (−1 if none).
+inline std::int32_t third_vertex(const mesh::Face& f, std::int32_t a, std::int32_t b) {
+  for (const auto v : f)
+    if (v != a && v != b) return v;
+  return -1;
+}
+
+struct SkinnedSoftBody::Impl::Piece {
+  // Memory the body's node, face and link arrays start in (see move_to_new_piece); declared
+  // first, so it outlives the body (which never frees memory it does not own).
+  struct Release {
+    void operator()(std::byte* p) const { ::operator delete[](p, std::align_val_t{16}); }
+  };
+  std::unique_ptr<std::byte[], Release> storage;
+  std::unique_ptr<btSoftBody> body;
+  std::vector<std::int32_t> node_vertex;  // node index → mesh vertex
+  std::vector<double> rest;               // link index → our rest length (Bullet resets its own)
+  std::vector<std::pair<std::int32_t, std::int32_t>> link_key;  // link → its key edge (min, max)
+  std::vector<std::uint8_t> link_bend;                          // link → 1 for a bending link
+  std::vector<std::int32_t> face_id;                            // Bullet face slot → mesh face
+  std::int32_t bending = 0;                                     // bending links in this body
+  bool reapply = true;  // rest lengths to write at the next update (set when built)
+};
+
+/// One whole connected piece on its way into a new body (move_to_new_piece and its steps).
+struct SkinnedSoftBody::Impl::PieceMove {
+  std::span<const std::int32_t> moving;  // its vertices; node i of the new body is moving[i]
+  std::vector<std::int32_t> sources;     // bodies the nodes leave (normally one)
+  std::vector<std::int32_t> faces;       // mesh faces, each once
+  std::vector<std::vector<std::uint8_t>> marks;  // per source body: per link, 1 if it moves
+  std::size_t link_count = 0;                    // links marked
+  std::int32_t into = -1;                        // the new body's index
+};
+
+inline btSoftBody* SkinnedSoftBody::Impl::body_of(std::int32_t v) const {
+  const std::int32_t p = piece_of_[static_cast<std::size_t>(v)];
+  return p < 0 ? nullptr : pieces_[static_cast<std::size_t>(p)]->body.get();
+}
+
+inline Eigen::Vector3d SkinnedSoftBody::Impl::position(std::int32_t v) const {
+  const auto i = static_cast<std::size_t>(v);
+  if (piece_of_[i] < 0) return detached_state_[static_cast<std::size_t>(detached_slot_[i])].first;
+  return from_bt(body_of(v)->m_nodes[node_of_[i]].m_x);
+}
+
+inline Eigen::Vector3d SkinnedSoftBody::Impl::velocity(std::int32_t v) const {
+  const auto i = static_cast<std::size_t>(v);
+  if (piece_of_[i] < 0) return detached_state_[static_cast<std::size_t>(detached_slot_[i])].second;
+  return from_bt(body_of(v)->m_nodes[node_of_[i]].m_v);
+}
+
+}  // namespace conform::bullet

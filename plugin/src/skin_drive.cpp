@@ -1,0 +1,202 @@
+// The skin drive: pose source → skinned targets (SkinDrive), and the per-substep update that
+// drives the Bullet nodes toward them (Impl::update).
+#include "skin_drive.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "piece_books.hpp"
+
+namespace conform::bullet {
+
+// --- Pose sources ---
+
+void SkinDrive::set_pose(const skin::Pose& pose) {
+  if (pose.local.size() != global_.size())
+    throw std::invalid_argument("set_pose: wrong joint count");
+  source_ = [pose](double, skin::Pose& out) { out = pose; };
+}
+
+void SkinDrive::play(const skin::Animation& animation, skin::Blend blend, bool loop) {
+  source_ = [skeleton = skeleton_, animation, blend, loop](double time, skin::Pose& out) {
+    const double d = animation.duration();
+    const double t = loop && d > 0 ? std::fmod(time, d) : time;
+    animation.sample(*skeleton, t, blend, out);
+  };
+}
+
+void SkinDrive::set_keyframes(skin::PoseTrack track, skin::Blend blend) {
+  source_ = [track = std::move(track), blend](double time, skin::Pose& out) {
+    track.sample(time, blend, out);
+  };
+}
+
+void SkinDrive::set_pose_source(std::function<void(double, skin::Pose&)> source) {
+  source_ = std::move(source);
+}
+
+// --- Skinned targets ---
+
+void SkinDrive::start(const mesh::SkinnedMesh& mesh) {
+  pose_ = skin::Pose::rest(*skeleton_);
+  global_.resize(static_cast<std::size_t>(skeleton_->joint_count()));
+  versors_.resize(static_cast<std::size_t>(skeleton_->bone_count()));
+  kernels_.resize(versors_.size());
+  rebuild_inputs(mesh);
+  skin(mesh, 0);
+  previous_ = target_;
+}
+
+void SkinDrive::rebuild_inputs(const mesh::SkinnedMesh& mesh) {
+  const auto n = static_cast<std::size_t>(mesh.vertex_count());
+  rest_ = skin::SoaPoints<double>::from(mesh.rest);
+  bones_.resize(n * mesh::kMaxInfluences);
+  weights_.resize(n * mesh::kMaxInfluences);
+  for (std::size_t v = 0; v < n; ++v)
+    for (std::size_t k = 0; k < std::size_t(mesh::kMaxInfluences); ++k) {
+      bones_[k * n + v] = mesh.bones(Eigen::Index(k), Eigen::Index(v));
+      weights_[k * n + v] = mesh.weights(Eigen::Index(k), Eigen::Index(v));
+    }
+  const std::size_t old = previous_.size();
+  target_.resize(n);
+  previous_.resize(n);
+  for (std::size_t v = old; v < n; ++v)
+    previous_.x[v] = previous_.y[v] = previous_.z[v] = std::nan("");
+  fill_previous_ = true;
+}
+
+void SkinDrive::skin(const mesh::SkinnedMesh& mesh, double time) {
+  if (rest_.size() != static_cast<std::size_t>(mesh.vertex_count())) rebuild_inputs(mesh);
+  if (source_) source_(time, pose_);
+  skin::global_versors(*skeleton_, pose_, global_);
+  skin::skinning_versors(*skeleton_, global_, versors_);
+  skin::versor_kernels<double>(versors_, kernels_);
+  skin::CgaSkinningJob<double> job;
+  job.kernels = kernels_;
+  job.input = {rest_.x, rest_.y, rest_.z, mesh::kMaxInfluences, bones_, weights_};
+  job.output = {target_.x, target_.y, target_.z};
+  job.threads = threads_;
+  job.run();
+}
+
+void SkinDrive::advance(const mesh::SkinnedMesh& mesh, double time) {
+  std::swap(previous_, target_);
+  skin(mesh, time);  // resizes both after vertices were added (new previous entries NaN)
+  if (!fill_previous_) return;
+  for (std::size_t v = 0; v < target_.size(); ++v)
+    if (std::isnan(previous_.x[v]))
+      previous_.x[v] = target_.x[v], previous_.y[v] = target_.y[v], previous_.z[v] = target_.z[v];
+  fill_previous_ = false;
+}
+
+// --- The per-substep drive ---
+
+void SkinnedSoftBody::Impl::update(double dt, double time) {
+  if (!(dt > 0)) return;
+  drive_.advance(mesh_, time);
+  for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot) {
+    // A detached vertex rides its target.
+    const auto v = static_cast<std::size_t>(detached_vertex_[slot]);
+    const Eigen::Vector3d t = drive_.target(std::int32_t(v)), tp = drive_.previous_target(v);
+    detached_state_[slot] = {t, (t - tp) / dt};
+  }
+  if (membrane_model()) {
+    step_membrane(dt);
+    return;
+  }
+  for (auto& piece : pieces_) {
+    if (!piece) continue;
+    drive_nodes(*piece, dt);
+    reapply_rest_lengths(*piece);
+  }
+}
+
+// The membrane's substep: kinematic nodes on their targets, then one membrane step of the
+// others (membrane_drive.hpp).
+void SkinnedSoftBody::Impl::step_membrane(double dt) {
+  const skin::SoaPoints<double>& target = drive_.targets();
+  const skin::SoaPoints<double>& previous = drive_.previous_targets();
+  const auto n = static_cast<std::size_t>(mesh_.vertex_count());
+  vertex_node_.assign(n, nullptr);
+  target_matrix_.resize(3, Eigen::Index(n));
+  previous_matrix_.resize(3, Eigen::Index(n));
+  for (std::size_t v = 0; v < n; ++v) {
+    target_matrix_.col(Eigen::Index(v)) << target.x[v], target.y[v], target.z[v];
+    previous_matrix_.col(Eigen::Index(v)) << previous.x[v], previous.y[v], previous.z[v];
+  }
+  for (auto& piece : pieces_) {
+    if (!piece) continue;
+    btSoftBody& body = *piece->body;
+    for (int i = 0; i < body.m_nodes.size(); ++i) {
+      btSoftBody::Node& node = body.m_nodes[i];
+      const auto v = static_cast<std::size_t>(piece->node_vertex[static_cast<std::size_t>(i)]);
+      vertex_node_[v] = &node;
+      if (!kinematic_[v]) continue;
+      const btVector3 t(btScalar(target.x[v]), btScalar(target.y[v]), btScalar(target.z[v]));
+      node.m_x = t;  // after Bullet's prediction: on the target; Bullet derives the velocity
+      node.m_v = (t - node.m_q) / btScalar(dt);
+    }
+  }
+  membrane_.step(mesh_, material_.skin, material_.solver, vertex_node_, kinematic_, mass_,
+                 target_matrix_, previous_matrix_, dt);
+}
+
+void SkinnedSoftBody::Impl::drive_nodes(Piece& piece, double dt) {
+  const skin::SoaPoints<double>& target = drive_.targets();
+  const skin::SoaPoints<double>& previous = drive_.previous_targets();
+  const double k = material_.target_stiffness, c = material_.target_damping;
+  const double dt2 = dt * dt, denom = 1 + c * dt + k * dt2;
+  const bool pull = k > 0 || c > 0;
+  btSoftBody& body = *piece.body;
+  for (int i = 0; i < body.m_nodes.size(); ++i) {
+    btSoftBody::Node& node = body.m_nodes[i];
+    const auto v = static_cast<std::size_t>(piece.node_vertex[static_cast<std::size_t>(i)]);
+    const btVector3 t(btScalar(target.x[v]), btScalar(target.y[v]), btScalar(target.z[v]));
+    if (kinematic_[v]) {
+      // After Bullet's prediction: place the node on its target; Bullet derives the velocity.
+      node.m_x = t;
+      node.m_v = (t - node.m_q) / btScalar(dt);
+    } else if (pull) {
+      // An implicit spring–damper toward the target, relative to the target's velocity.
+      const btVector3 tp(btScalar(previous.x[v]), btScalar(previous.y[v]), btScalar(previous.z[v]));
+      const btVector3 target_velocity = (t - tp) / btScalar(dt);
+      const btVector3 error = t - node.m_x;
+      const btVector3 relative = (node.m_x - node.m_q) / btScalar(dt) - target_velocity;
+      node.m_x += (error * btScalar(k) - relative * btScalar(c)) * btScalar(dt2 / denom);
+    }
+  }
+}
+
+void SkinnedSoftBody::Impl::reapply_rest_lengths(Piece& piece) {
+  // Bullet resets every rest length at once (updateConstants, after any edit); one link
+  // tells whether it happened since we last wrote them, and then ours (with pretension) win.
+  btSoftBody& body = *piece.body;
+  if (!piece.reapply &&
+      (body.m_links.size() == 0 || body.m_links[0].m_rl == btScalar(piece.rest[0])))
+    return;
+  piece.reapply = false;
+  for (int i = 0; i < body.m_links.size(); ++i) {
+    const double r = piece.rest[static_cast<std::size_t>(i)];
+    body.m_links[i].m_rl = btScalar(r);
+    body.m_links[i].m_c1 = btScalar(r * r);
+  }
+}
+
+void SkinnedSoftBody::Impl::skin_targets(double time) {
+  drive_.skin(mesh_, time);
+}
+
+void SkinnedSoftBody::Impl::set_pinned(std::span<const std::int32_t> vertices) {
+  std::fill(pinned_.begin(), pinned_.end(), 0);
+  for (const auto v : vertices) pinned_.at(static_cast<std::size_t>(v)) = 1;
+  for (std::int32_t v = 0; v < vertex_count(); ++v) {
+    const auto i = static_cast<std::size_t>(v);
+    const bool k = pinned_[i] || is_kinematic_by_weight(v);
+    if (k == bool(kinematic_[i])) continue;
+    kinematic_[i] = k;
+    set_node_mass(v);  // and the constants of its links
+  }
+}
+
+}  // namespace conform::bullet

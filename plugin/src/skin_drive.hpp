@@ -1,0 +1,67 @@
+// The skin drive's source side: the pose source gives a skeleton pose at the plugin's time, and
+// CGA skinning (eq 17) of the rest points gives every vertex its target; the previous substep's
+// targets are kept for target velocities. No Bullet here: Impl::update (skin_drive.cpp), the
+// one per-substep entry point, drives the nodes toward these targets.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "conform/mesh/skinned_mesh.hpp"
+#include "conform/skin/animation.hpp"
+#include "conform/skin/pose.hpp"
+#include "conform/skin/skeleton.hpp"
+#include "conform/skin/skinning.hpp"
+
+namespace conform::bullet {
+
+class SkinDrive {
+ public:
+  /// `skeleton` must outlive the drive.
+  explicit SkinDrive(const skin::Skeleton& skeleton) : skeleton_(&skeleton) {}
+
+  // Pose sources (the last one set wins). Time is the plugin's simulated time, s.
+  void set_pose(const skin::Pose& pose);
+  void play(const skin::Animation& animation, skin::Blend blend, bool loop);
+  void set_keyframes(skin::PoseTrack track, skin::Blend blend);
+  void set_pose_source(std::function<void(double time, skin::Pose& pose)> source);
+  void set_threads(int threads) { threads_ = threads; }
+
+  /// The rest pose, the mesh's skinning inputs and its targets at time 0 (previous = target).
+  void start(const mesh::SkinnedMesh& mesh);
+  /// Skins the rest points at `time` into the targets (re-reading the mesh's skinning inputs
+  /// once vertices were added).
+  void skin(const mesh::SkinnedMesh& mesh, double time);
+  /// A substep's start: the targets become the previous ones, then skin(time); a vertex added
+  /// since gets its target as its previous one (zero target velocity).
+  void advance(const mesh::SkinnedMesh& mesh, double time);
+
+  const skin::SoaPoints<double>& targets() const { return target_; }
+  const skin::SoaPoints<double>& previous_targets() const { return previous_; }
+  Eigen::Vector3d target(std::int32_t v) const {
+    const auto i = static_cast<std::size_t>(v);
+    return {target_.x.at(i), target_.y.at(i), target_.z.at(i)};
+  }
+  Eigen::Vector3d previous_target(std::size_t v) const {
+    return {previous_.x[v], previous_.y[v], previous_.z[v]};
+  }
+
+ private:
+  void rebuild_inputs(const mesh::SkinnedMesh& mesh);
+
+  const skin::Skeleton* skeleton_;
+  std::function<void(double, skin::Pose&)> source_;
+  skin::Pose pose_;
+  std::vector<skin::Versor> global_, versors_;
+  std::vector<skin::Kernel34<double>> kernels_;
+  // Skinning inputs/outputs, SoA (see skinning.hpp), rebuilt when vertices are added.
+  skin::SoaPoints<double> rest_, target_, previous_;
+  std::vector<std::int32_t> bones_;
+  std::vector<double> weights_;
+  bool fill_previous_ = false;  // vertices were added: their previous targets are NaN
+  int threads_ = 1;
+};
+
+}  // namespace conform::bullet
