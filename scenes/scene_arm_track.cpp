@@ -24,7 +24,7 @@
 
 #include "conform/bullet/convert.hpp"
 #include "conform/ik/arm_ik.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 #include "scene.hpp"
 

@@ -14,7 +14,7 @@
 
 #include "conform/io/import.hpp"
 #include "conform/mesh/analysis.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 #include "scene.hpp"
 #include "soft_scene.hpp"

@@ -12,7 +12,7 @@
 #include <numbers>
 #include <sstream>
 
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 #include "scene.hpp"
 #include "soft_scene.hpp"

@@ -13,7 +13,7 @@
 #include <unordered_map>
 
 #include "conform/io/crash_guard.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 
 namespace conform::io {
