@@ -229,7 +229,7 @@ Solution<T> solve_readable(const Arm<T>& arm, const Vec3<T>& target, T swivel);
 
 /// Many targets for one arm, structure of arrays (ozz-style job: owns no buffers).
 /// Every span must have the size of `x`. Qe is returned as qe_w + qe_x i (its y, z are 0).
-/// The elbow range limit is honoured; the shoulder cone is not (Validate() rejects it).
+/// The elbow range limit is honoured; the shoulder cone is not (validate() rejects it).
 template <class T>
 struct BatchSolveJob {
   Arm<T> arm;
@@ -240,9 +240,13 @@ struct BatchSolveJob {
   std::span<std::uint8_t> status;  // Status bits
   int threads = 0;                 // OpenMP threads; 0 = OpenMP's default, 1 = this thread only
 
-  bool Validate() const;
-  /// Runs the job; false (and nothing written) when Validate() fails.
-  bool Run() const;
+  /// Empty when the job can run; else the first bad input, named with its value.
+  std::string validate() const;
+  /// Runs the job; false (and nothing written) when validate() is not empty.
+  bool run() const;
+  /// The first spelling of the same pair (ozz's), kept for existing callers.
+  bool Validate() const { return validate().empty(); }
+  bool Run() const { return run(); }
 };
 
 extern template struct BatchSolveJob<float>;
