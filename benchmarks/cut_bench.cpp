@@ -39,7 +39,7 @@
 
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/cut.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "mesh_bench_util.hpp"
 
 #if CONFORM_HAVE_CGAL

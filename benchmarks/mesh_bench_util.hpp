@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 
 namespace conform::bench {
 

@@ -10,7 +10,7 @@
 #include "../tests/plugin_world.hpp"
 #include "conform/bullet/plugin.hpp"
 #include "conform/mesh/primitives.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "ratio_reporter.hpp"
 
 using namespace conform;

@@ -36,8 +36,8 @@
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/face_index.hpp"
-#include "conform/mesh/procedural_arm.hpp"
 #include "conform/mesh/tear.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "mesh_bench_util.hpp"
 
 using namespace conform::mesh;

@@ -140,129 +140,142 @@ std::vector<mesh::ScalpelSample> read_scalpel(const std::string& file) {
 
 }  // namespace
 
+namespace {
+
+// `conform cut`: a plane through the model (Algorithm 1), the pieces written out.
+void register_cut(CLI::App& app, Context& context) {
+  auto common = std::make_shared<Common>();
+  auto plane = std::make_shared<std::vector<double>>();
+  auto cap = std::make_shared<bool>(false);
+  auto* cmd =
+      app.add_subcommand("cut", "Cut a model by a plane (Algorithm 1) and write the pieces");
+  add_common(cmd, *common);
+  cmd->add_option("--plane", *plane, "unit normal and distance: NX NY NZ D (n·x = D)")
+      ->expected(4)
+      ->required();
+  cmd->add_flag("--cap", *cap, "close every cut loop with a triangulated cap");
+  cmd->callback([&context, common, plane, cap]() {
+    run(context, "cut", [&] {
+      nlohmann::json summary;
+      summary["command"] = "cut";
+      mesh::SkinnedMesh m = load(*common, summary);
+      const auto& p = *plane;
+      const auto t0 = Clock::now();
+      mesh::Adjacency adjacency(m);
+      const double t_adj = ms_since(t0);
+      const auto t1 = Clock::now();
+      const mesh::CutOutcome out = mesh::cut(
+          m, adjacency, cga::Plane<double>::from_normal_distance({p[0], p[1], p[2]}, p[3]),
+          {.cap = *cap});
+      summary["timing_ms"]["adjacency"] = t_adj;
+      summary["timing_ms"]["operation"] = ms_since(t1);
+      summary["status"] = out.result.status == mesh::CutStatus::Cut ? "cut" : "missed";
+      summary["crossed_edges"] = out.result.crossed_edges;
+      summary["snapped_vertices"] = out.result.snapped_vertices;
+      summary["new_vertices"] = out.result.change.new_vertices.size();
+      if (*cap)
+        summary["cap"] = {{"loops", out.result.loops},
+                          {"capped", out.result.capped_loops},
+                          {"faces_per_side", out.result.cap_faces}};
+      if (!out.result.message.empty()) summary["message"] = out.result.message;
+      if (out.result.status != mesh::CutStatus::Cut)
+        std::cerr << "conform cut: " << out.result.message << " (no-op)\n";
+      write_pieces(*common, m, summary);
+    });
+  });
+}
+
+// `conform tear`: a scalpel path through the model (Algorithm 2).
+void register_tear(CLI::App& app, Context& context) {
+  auto common = std::make_shared<Common>();
+  auto scalpel = std::make_shared<std::string>();
+  auto open = std::make_shared<double>(0.0);
+  auto* cmd = app.add_subcommand("tear", "Tear a model along a scalpel path (Algorithm 2)");
+  add_common(cmd, *common);
+  cmd->add_option("--scalpel", *scalpel, "CSV with header t,ax,ay,az,bx,by,bz")->required();
+  cmd->add_option("--open", *open, "move the tear's two borders apart by this much (m)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([&context, common, scalpel, open]() {
+    run(context, "tear", [&] {
+      nlohmann::json summary;
+      summary["command"] = "tear";
+      const auto samples = read_scalpel(*scalpel);
+      mesh::SkinnedMesh m = load(*common, summary);
+      const auto t0 = Clock::now();
+      mesh::Adjacency adjacency(m);
+      const double t_adj = ms_since(t0);
+      const auto t1 = Clock::now();
+      mesh::Tear tear(m, adjacency);
+      for (const auto& s : samples) tear.advance(s);
+      if (*open > 0) tear.open(*open);
+      summary["timing_ms"]["adjacency"] = t_adj;
+      summary["timing_ms"]["operation"] = ms_since(t1);
+      summary["samples"] = samples.size();
+      summary["tear"] = {
+          {"steps", tear.steps()}, {"points", tear.path_length()}, {"length", tear.length()}};
+      if (!tear.message().empty()) summary["message"] = tear.message();
+      if (tear.steps() == 0)
+        throw std::runtime_error("the scalpel never tore the surface: " + tear.message());
+      write_pieces(*common, m, summary);
+    });
+  });
+}
+
+// `conform drill`: a cylindrical hole (Algorithm 3).
+void register_drill(CLI::App& app, Context& context) {
+  auto common = std::make_shared<Common>();
+  auto tip = std::make_shared<std::vector<double>>();
+  auto base = std::make_shared<std::vector<double>>();
+  auto radius = std::make_shared<double>(0.0);
+  auto options = std::make_shared<mesh::DrillOptions>();
+  auto* cmd = app.add_subcommand("drill", "Drill a cylindrical hole (Algorithm 3)");
+  add_common(cmd, *common);
+  cmd->add_option("--tip", *tip, "drill tip A: X Y Z")->expected(3)->required();
+  cmd->add_option("--base", *base, "drill base B: X Y Z")->expected(3)->required();
+  cmd->add_option("--radius", *radius, "drill radius (m)")->required();
+  cmd->add_flag("--tube", options->tube,
+                "join the entry and exit holes of a closed surface with a tube wall");
+  cmd->add_option("--tube-rings", options->tube_ring_spacing,
+                  "with --tube: rings of new vertices at most SPACING x the rims' mean edge "
+                  "apart (0: one triangle spans the wall)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([&context, common, tip, base, radius, options]() {
+    run(context, "drill", [&] {
+      nlohmann::json summary;
+      summary["command"] = "drill";
+      mesh::SkinnedMesh m = load(*common, summary);
+      const auto& a = *tip;
+      const auto& b = *base;
+      const auto t0 = Clock::now();
+      mesh::Adjacency adjacency(m);
+      const double t_adj = ms_since(t0);
+      const auto t1 = Clock::now();
+      if (options->tube_ring_spacing > 0 && !options->tube)
+        throw std::runtime_error("--tube-rings needs --tube");
+      const mesh::DrillResult r =
+          mesh::drill(m, adjacency, {{a[0], a[1], a[2]}, {b[0], b[1], b[2]}, *radius}, *options);
+      summary["timing_ms"]["adjacency"] = t_adj;
+      summary["timing_ms"]["operation"] = ms_since(t1);
+      summary["holes"] = r.holes;
+      summary["rim_vertices"] = r.rim_vertices;
+      summary["removed_faces"] = r.removed_area_faces;
+      summary["removed_area"] = r.removed_area;
+      summary["refinements"] = r.refinements;
+      if (options->tube) summary["tube"] = {{"tubes", r.tubes}, {"faces", r.tube_faces}};
+      if (!r.message.empty()) summary["message"] = r.message;
+      if (r.holes == 0)
+        throw std::runtime_error("the drill does not pierce the surface: " + r.message);
+      write_pieces(*common, m, summary);
+    });
+  });
+}
+
+}  // namespace
+
 void register_mesh_ops(CLI::App& app, Context& context) {
-  {
-    auto common = std::make_shared<Common>();
-    auto plane = std::make_shared<std::vector<double>>();
-    auto cap = std::make_shared<bool>(false);
-    auto* cmd =
-        app.add_subcommand("cut", "Cut a model by a plane (Algorithm 1) and write the pieces");
-    add_common(cmd, *common);
-    cmd->add_option("--plane", *plane, "unit normal and distance: NX NY NZ D (n·x = D)")
-        ->expected(4)
-        ->required();
-    cmd->add_flag("--cap", *cap, "close every cut loop with a triangulated cap");
-    cmd->callback([&context, common, plane, cap]() {
-      run(context, "cut", [&] {
-        nlohmann::json summary;
-        summary["command"] = "cut";
-        mesh::SkinnedMesh m = load(*common, summary);
-        const auto& p = *plane;
-        const auto t0 = Clock::now();
-        mesh::Adjacency adjacency(m);
-        const double t_adj = ms_since(t0);
-        const auto t1 = Clock::now();
-        const mesh::CutOutcome out = mesh::cut(
-            m, adjacency, cga::Plane<double>::from_normal_distance({p[0], p[1], p[2]}, p[3]),
-            {.cap = *cap});
-        summary["timing_ms"]["adjacency"] = t_adj;
-        summary["timing_ms"]["operation"] = ms_since(t1);
-        summary["status"] = out.result.status == mesh::CutStatus::Cut ? "cut" : "missed";
-        summary["crossed_edges"] = out.result.crossed_edges;
-        summary["snapped_vertices"] = out.result.snapped_vertices;
-        summary["new_vertices"] = out.result.change.new_vertices.size();
-        if (*cap)
-          summary["cap"] = {{"loops", out.result.loops},
-                            {"capped", out.result.capped_loops},
-                            {"faces_per_side", out.result.cap_faces}};
-        if (!out.result.message.empty()) summary["message"] = out.result.message;
-        if (out.result.status != mesh::CutStatus::Cut)
-          std::cerr << "conform cut: " << out.result.message << " (no-op)\n";
-        write_pieces(*common, m, summary);
-      });
-    });
-  }
-  {
-    auto common = std::make_shared<Common>();
-    auto scalpel = std::make_shared<std::string>();
-    auto open = std::make_shared<double>(0.0);
-    auto* cmd = app.add_subcommand("tear", "Tear a model along a scalpel path (Algorithm 2)");
-    add_common(cmd, *common);
-    cmd->add_option("--scalpel", *scalpel, "CSV with header t,ax,ay,az,bx,by,bz")->required();
-    cmd->add_option("--open", *open, "move the tear's two borders apart by this much (m)")
-        ->check(CLI::NonNegativeNumber);
-    cmd->callback([&context, common, scalpel, open]() {
-      run(context, "tear", [&] {
-        nlohmann::json summary;
-        summary["command"] = "tear";
-        const auto samples = read_scalpel(*scalpel);
-        mesh::SkinnedMesh m = load(*common, summary);
-        const auto t0 = Clock::now();
-        mesh::Adjacency adjacency(m);
-        const double t_adj = ms_since(t0);
-        const auto t1 = Clock::now();
-        mesh::Tear tear(m, adjacency);
-        for (const auto& s : samples) tear.advance(s);
-        if (*open > 0) tear.open(*open);
-        summary["timing_ms"]["adjacency"] = t_adj;
-        summary["timing_ms"]["operation"] = ms_since(t1);
-        summary["samples"] = samples.size();
-        summary["tear"] = {
-            {"steps", tear.steps()}, {"points", tear.path_length()}, {"length", tear.length()}};
-        if (!tear.message().empty()) summary["message"] = tear.message();
-        if (tear.steps() == 0)
-          throw std::runtime_error("the scalpel never tore the surface: " + tear.message());
-        write_pieces(*common, m, summary);
-      });
-    });
-  }
-  {
-    auto common = std::make_shared<Common>();
-    auto tip = std::make_shared<std::vector<double>>();
-    auto base = std::make_shared<std::vector<double>>();
-    auto radius = std::make_shared<double>(0.0);
-    auto options = std::make_shared<mesh::DrillOptions>();
-    auto* cmd = app.add_subcommand("drill", "Drill a cylindrical hole (Algorithm 3)");
-    add_common(cmd, *common);
-    cmd->add_option("--tip", *tip, "drill tip A: X Y Z")->expected(3)->required();
-    cmd->add_option("--base", *base, "drill base B: X Y Z")->expected(3)->required();
-    cmd->add_option("--radius", *radius, "drill radius (m)")->required();
-    cmd->add_flag("--tube", options->tube,
-                  "join the entry and exit holes of a closed surface with a tube wall");
-    cmd->add_option("--tube-rings", options->tube_ring_spacing,
-                    "with --tube: rings of new vertices at most SPACING x the rims' mean edge "
-                    "apart (0: one triangle spans the wall)")
-        ->check(CLI::NonNegativeNumber);
-    cmd->callback([&context, common, tip, base, radius, options]() {
-      run(context, "drill", [&] {
-        nlohmann::json summary;
-        summary["command"] = "drill";
-        mesh::SkinnedMesh m = load(*common, summary);
-        const auto& a = *tip;
-        const auto& b = *base;
-        const auto t0 = Clock::now();
-        mesh::Adjacency adjacency(m);
-        const double t_adj = ms_since(t0);
-        const auto t1 = Clock::now();
-        if (options->tube_ring_spacing > 0 && !options->tube)
-          throw std::runtime_error("--tube-rings needs --tube");
-        const mesh::DrillResult r =
-            mesh::drill(m, adjacency, {{a[0], a[1], a[2]}, {b[0], b[1], b[2]}, *radius}, *options);
-        summary["timing_ms"]["adjacency"] = t_adj;
-        summary["timing_ms"]["operation"] = ms_since(t1);
-        summary["holes"] = r.holes;
-        summary["rim_vertices"] = r.rim_vertices;
-        summary["removed_faces"] = r.removed_area_faces;
-        summary["removed_area"] = r.removed_area;
-        summary["refinements"] = r.refinements;
-        if (options->tube) summary["tube"] = {{"tubes", r.tubes}, {"faces", r.tube_faces}};
-        if (!r.message.empty()) summary["message"] = r.message;
-        if (r.holes == 0)
-          throw std::runtime_error("the drill does not pierce the surface: " + r.message);
-        write_pieces(*common, m, summary);
-      });
-    });
-  }
+  register_cut(app, context);
+  register_tear(app, context);
+  register_drill(app, context);
 }
 
 }  // namespace conform::cli

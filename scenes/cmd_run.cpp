@@ -112,7 +112,7 @@ void register_scenes(CLI::App& app, Context& context) {
       std::cout << b->json << "\n";
       return;
     }
-    for (const auto& s : scenes::builtin_scenes())
+    for (const auto& s : scenes::scene_kinds())
       std::cout << std::left << std::setw(14) << s.name << " " << s.summary << "\n";
   });
 }

@@ -1,6 +1,7 @@
 // Scene kinds of `conform run`: each parses its JSON (strictly, writing nothing) into a
-// prepared scene, which then runs into a RunOutput folder. Built-in scenes are JSON texts
-// compiled into the command (builtin_scenes.cpp); `conform scenes --show NAME` prints one.
+// prepared scene, which then runs into a RunOutput folder. Each kind's file holds its default
+// JSON (the built-in scene of the same name) and registers both (scene_registry.cpp keeps
+// the list); `conform scenes --show NAME` prints one.
 #pragma once
 
 #include <filesystem>
@@ -30,29 +31,26 @@ class Scene {
 using SceneFactory = std::unique_ptr<Scene> (*)(const Json& scene, const std::string& name,
                                                 int steps_override);
 
+/// A scene kind and its built-in scene of the same name: the scene's own file registers it
+/// (see SceneRegistration), so adding a scene is adding one file.
 struct SceneKind {
   const char* name;
-  SceneFactory factory;
-};
-
-std::unique_ptr<Scene> make_arm_track(const Json&, const std::string&, int);
-std::unique_ptr<Scene> make_tear_opening(const Json&, const std::string&, int);
-std::unique_ptr<Scene> make_membrane_slit(const Json&, const std::string&, int);
-std::unique_ptr<Scene> make_cut(const Json&, const std::string&, int);
-std::unique_ptr<Scene> make_drill(const Json&, const std::string&, int);
-std::unique_ptr<Scene> make_character(const Json&, const std::string&, int);
-
-/// The kinds that exist in this build.
-const std::vector<SceneKind>& scene_kinds();
-
-struct BuiltinScene {
-  const char* name;
   const char* summary;  // one line for `conform scenes`
-  const char* json;     // the scene file
+  const char* json;     // the built-in scene file (`conform scenes --show NAME`)
+  SceneFactory factory;
+  int rank;  // position in `conform scenes` (smaller first)
 };
-const std::vector<BuiltinScene>& builtin_scenes();
-/// The built-in scene of that name, or nullptr.
-const BuiltinScene* find_builtin(const std::string& name);
+
+/// Registers a scene kind during static initialisation. In the scene's file:
+///   const SceneRegistration kRegistration{{"name", "summary", kJson, &make, rank}};
+struct SceneRegistration {
+  explicit SceneRegistration(const SceneKind& kind);
+};
+
+/// The registered kinds, by rank (complete once main() runs).
+const std::vector<SceneKind>& scene_kinds();
+/// The scene kind of that name, or nullptr.
+const SceneKind* find_builtin(const std::string& name);
 
 /// Parses a scene given by built-in name or JSON file path, applies --set assignments, and
 /// prepares it. Throws SceneError or std::runtime_error (unreadable file, bad JSON).

@@ -18,6 +18,20 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// The built-in scene `membrane-slit` (`conform scenes --show membrane-slit`).
+constexpr const char* kMembraneSlitJson = R"json({
+  "scene": "membrane-slit",
+  "description": "A square sheet of skin membrane (SI units) pinned at its border and pre-stressed by material.prestress = [sigma_xx, sigma_yy] along its axes is slit through its centre by a topology change on the live Bullet soft body; it settles, and its opening is compared with linear elastic fracture mechanics (plane stress): w_max = 4 sigma_n a / E.",
+  "duration": 1.0,
+  "sheet": { "width": 0.8, "resolution": 0.0025, "tip_refinement": 16 },
+  "slit": { "length": 0.05, "angle_deg": 0, "at": 0.1 },
+  "material": { "prestress": [400, 400], "youngs_modulus": 420000, "poisson_ratio": 0.48,
+                "thickness": 0.0015, "attachment_stiffness": 0,
+                "attachment_normal_stiffness": 0, "tolerance": 0.4, "max_cg_iterations": 4000 },
+  "physics": { "dt": 0.016666666666666666, "substeps": 1, "gravity": [0, 0, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 0, "plots": true }
+})json";
+
 skin::Skeleton one_bone() {
   skin::Skeleton s;
   s.joints.push_back({"root", -1, skin::Versor::identity()});
@@ -165,11 +179,17 @@ class MembraneSlit final : public Scene {
   bool body_converged_ = true;
 };
 
-}  // namespace
-
 std::unique_ptr<Scene> make_membrane_slit(const Json& scene, const std::string& name,
                                           int steps_override) {
   return std::make_unique<MembraneSlit>(scene, name, steps_override);
 }
+
+const SceneRegistration kMembraneSlitRegistration{
+    {"membrane-slit",
+     "the skin membrane against LEFM: a pinned, pre-stressed sheet slit through its centre "
+     "opens as an ellipse of maximum 4 sigma_n a / E",
+     kMembraneSlitJson, &make_membrane_slit, 5}};
+
+}  // namespace
 
 }  // namespace conform::scenes

@@ -14,13 +14,59 @@
 
 #include "conform/io/import.hpp"
 #include "conform/mesh/analysis.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 #include "scene.hpp"
 #include "soft_scene.hpp"
 
 namespace conform::scenes {
 namespace {
+
+// The built-in scene `cut`, the defaults of this kind (`conform scenes --show cut`).
+constexpr const char* kCutJson = R"json({
+  "scene": "cut",
+  "description": "The moving procedural arm as a CGA-skinned Bullet soft body (every node pulled toward its skinned target) is cut through the forearm by a plane; both pieces keep simulating under gravity and the hand piece keeps following the wrist and hand bones.",
+  "seed": 1,
+  "duration": 3.0,
+  "model": { "resolution": 1 },
+  "pose": { "shoulder_swing_deg": 20, "elbow_deg": 10, "elbow_swing_deg": 40, "period": 2 },
+  "material": { "target_stiffness": 4000, "target_damping": 40, "kinematic_weight": 2,
+                "damping": 0.02 },
+  "cut": { "at": 0.5, "point": [0, 0, 0.4234], "normal": [0, 0.05, 1], "cap": false },
+  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json";
+// The built-in scene `drill`, the defaults of this kind (`conform scenes --show drill`).
+constexpr const char* kDrillJson = R"json({
+  "scene": "drill",
+  "description": "A cylindrical drill (radius 12 mm) goes through both walls of the upper arm of the CGA-skinned soft arm; the arm then swings and flexes, and the rim nodes are measured against their skinned targets.",
+  "seed": 1,
+  "duration": 3.0,
+  "model": { "resolution": 1 },
+  "pose": { "shoulder_swing_deg": 20, "elbow_deg": 10, "elbow_swing_deg": 40, "period": 2 },
+  "material": { "target_stiffness": 4000, "target_damping": 40, "kinematic_weight": 2,
+                "damping": 0.02 },
+  "drill": { "at": 0.5, "tip": [0.1, 0.0031, 0.1512], "base": [-0.1, 0.0031, 0.1512],
+             "radius": 0.012 },
+  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json";
+// The built-in scene `character`, the defaults of this kind (`conform scenes --show character`).
+constexpr const char* kCharacterJson = R"json({
+  "scene": "character",
+  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body: nodes close to one bone ride it, blended regions follow their skinned targets softly.",
+  "seed": 1,
+  "duration": 1.56,
+  "model": { "file": "/usr/share/assimp/models/FBX/huesitos.fbx", "animation": "0",
+             "units_per_metre": 100 },
+  "material": { "link_stiffness": 0.02, "target_stiffness": 2000, "target_damping": 20,
+                "kinematic_weight": 0.95, "damping": 0.01 },
+  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json";
 
 using Clock = std::chrono::steady_clock;
 using Vec3 = Eigen::Vector3d;
@@ -148,7 +194,6 @@ class ArmEventScene : public Scene {
     const skin::Pose rest = skin::Pose::rest(arm.skeleton);
     const ArmMotion motion = motion_;
     body.set_pose_source([motion, rest](double t, skin::Pose& p) { motion.pose(rest, t, p); });
-    const std::int32_t fingertip = arm.mesh.vertex_count() - 1;  // the hand's pole
 
     const bool is_cut = kind_ == Kind::cut;
     out.open_metrics(is_cut ? std::vector<std::string>{"t", "pieces", "offset_mean", "offset_max",
@@ -174,52 +219,8 @@ class ArmEventScene : public Scene {
       if (!done && t >= at_ - 1e-12) {
         done = true;
         const auto te = Clock::now();
-        const std::int32_t before = body.vertex_count();
-        if (is_cut) {
-          mesh::CutOptions options;
-          options.cap = cap_;
-          // The plane is given in the rest arm and moves with the forearm (bone 1).
-          const Vec3 p = carried(arm.skeleton, motion_, t, 1, point_);
-          const Vec3 n = carried(arm.skeleton, motion_, t, 1, point_ + normal_.normalized()) - p;
-          const auto r =
-              body.cut(cga::Plane<double>::from_normal_point(n.normalized(), p), options);
-          event = {{"status", r.status == mesh::CutStatus::Cut ? "cut" : "missed"},
-                   {"crossed_edges", r.crossed_edges},
-                   {"new_vertices", body.vertex_count() - before},
-                   {"capped_loops", r.capped_loops}};
-          if (r.status != mesh::CutStatus::Cut)
-            throw std::runtime_error("cut: the plane missed the arm");
-          const mesh::Pieces pieces = mesh::label_pieces(body.mesh());
-          // The hand piece: the faces' piece holding the finger tips.
-          std::vector<std::int32_t> piece_of(static_cast<std::size_t>(body.vertex_count()), -1);
-          for (std::int32_t f = 0; f < body.mesh().face_count(); ++f)
-            for (const std::int32_t v : body.mesh().faces[static_cast<std::size_t>(f)])
-              piece_of[static_cast<std::size_t>(v)] =
-                  pieces.face_piece[static_cast<std::size_t>(f)];
-          const std::int32_t hand = piece_of[static_cast<std::size_t>(fingertip)];
-          for (std::int32_t v = 0; v < body.vertex_count(); ++v)
-            (piece_of[static_cast<std::size_t>(v)] == hand ? special : others).push_back(v);
-          event["hand_piece_vertices"] = special.size();
-        } else {
-          // The drill is given in the rest arm and moves with the upper arm (bone 0).
-          const mesh::DrillTool tool{carried(arm.skeleton, motion_, t, 0, tip_),
-                                     carried(arm.skeleton, motion_, t, 0, base_), radius_};
-          const auto r = body.drill(tool);
-          event = {{"holes", r.holes},
-                   {"rim_vertices", r.rim_vertices},
-                   {"removed_area", r.removed_area},
-                   {"refinements", r.refinements},
-                   {"new_vertices", body.vertex_count() - before}};
-          holes = r.holes;
-          if (r.holes == 0)
-            throw std::runtime_error("drill: the drill missed the arm: " + r.message);
-          // The rim: vertices on the cylinder when drilled (new and snapped ones).
-          for (std::int32_t v = 0; v < body.vertex_count(); ++v) {
-            const double d = std::sqrt(mesh::axis_distance_squared(tool, body.position(v)));
-            (std::abs(d - radius_) < 0.02 * radius_ ? special : others).push_back(v);
-          }
-          event["rim_nodes"] = special.size();
-        }
+        event = is_cut ? cut_at(body, arm, t, special, others)
+                       : drill_at(body, arm, t, holes, special, others);
         event_ms = std::chrono::duration<double, std::milli>(Clock::now() - te).count();
         continue;  // offsets are measured once the plugin has skinned the new vertices
       }
@@ -253,6 +254,67 @@ class ArmEventScene : public Scene {
       throw std::runtime_error(std::string(is_cut ? "cut" : "drill") + ": the event at " +
                                std::to_string(at_) + " s is after the last step");
     if (!finite_nodes(body)) throw std::runtime_error("the soft body blew up (non-finite nodes)");
+    const Json metrics = summary(body, event, all_special, worst_special, special_samples);
+    add_plot(out);
+    Json timings = {{"physics_ms_per_step", physics_ms / c.steps}, {"event_ms", event_ms}};
+    out.finish(resolved_, metrics, timings, c.steps, c.steps * c.dt, loop_s);
+    return metrics;
+  }
+
+  // The cut at time t, its plane given in the rest arm and moved with the forearm (bone 1);
+  // `special` gets the hand piece's vertices (the piece of the finger tips), `others` the rest.
+  Json cut_at(bullet::SkinnedSoftBody& body, const mesh::Arm& arm, double t,
+              std::vector<std::int32_t>& special, std::vector<std::int32_t>& others) const {
+    const std::int32_t fingertip = arm.mesh.vertex_count() - 1;  // the hand's pole
+    const std::int32_t before = body.vertex_count();
+    mesh::CutOptions options;
+    options.cap = cap_;
+    const Vec3 p = carried(arm.skeleton, motion_, t, 1, point_);
+    const Vec3 n = carried(arm.skeleton, motion_, t, 1, point_ + normal_.normalized()) - p;
+    const auto r = body.cut(cga::Plane<double>::from_normal_point(n.normalized(), p), options);
+    Json event = {{"status", r.status == mesh::CutStatus::Cut ? "cut" : "missed"},
+                  {"crossed_edges", r.crossed_edges},
+                  {"new_vertices", body.vertex_count() - before},
+                  {"capped_loops", r.capped_loops}};
+    if (r.status != mesh::CutStatus::Cut) throw std::runtime_error("cut: the plane missed the arm");
+    const mesh::Pieces pieces = mesh::label_pieces(body.mesh());
+    std::vector<std::int32_t> piece_of(static_cast<std::size_t>(body.vertex_count()), -1);
+    for (std::int32_t f = 0; f < body.mesh().face_count(); ++f)
+      for (const std::int32_t v : body.mesh().faces[static_cast<std::size_t>(f)])
+        piece_of[static_cast<std::size_t>(v)] = pieces.face_piece[static_cast<std::size_t>(f)];
+    const std::int32_t hand = piece_of[static_cast<std::size_t>(fingertip)];
+    for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+      (piece_of[static_cast<std::size_t>(v)] == hand ? special : others).push_back(v);
+    event["hand_piece_vertices"] = special.size();
+    return event;
+  }
+
+  // The drill at time t, given in the rest arm and moved with the upper arm (bone 0);
+  // `special` gets the rim (vertices on the cylinder when drilled: new and snapped ones).
+  Json drill_at(bullet::SkinnedSoftBody& body, const mesh::Arm& arm, double t, int& holes,
+                std::vector<std::int32_t>& special, std::vector<std::int32_t>& others) const {
+    const std::int32_t before = body.vertex_count();
+    const mesh::DrillTool tool{carried(arm.skeleton, motion_, t, 0, tip_),
+                               carried(arm.skeleton, motion_, t, 0, base_), radius_};
+    const auto r = body.drill(tool);
+    Json event = {{"holes", r.holes},
+                  {"rim_vertices", r.rim_vertices},
+                  {"removed_area", r.removed_area},
+                  {"refinements", r.refinements},
+                  {"new_vertices", body.vertex_count() - before}};
+    holes = r.holes;
+    if (r.holes == 0) throw std::runtime_error("drill: the drill missed the arm: " + r.message);
+    for (std::int32_t v = 0; v < body.vertex_count(); ++v) {
+      const double d = std::sqrt(mesh::axis_distance_squared(tool, body.position(v)));
+      (std::abs(d - radius_) < 0.02 * radius_ ? special : others).push_back(v);
+    }
+    event["rim_nodes"] = special.size();
+    return event;
+  }
+
+  Json summary(const bullet::SkinnedSoftBody& body, const Json& event,
+               const OffsetStats& all_special, const OffsetStats& worst_special,
+               long special_samples) const {
     const OffsetStats final_all = offsets(body, {});
     Json metrics;
     metrics["event"] = event;
@@ -260,11 +322,16 @@ class ArmEventScene : public Scene {
     metrics["nodes"] = body.vertex_count();
     metrics["offset_mean"] = final_all.mean;
     metrics["offset_max"] = final_all.max;
-    const std::string what = is_cut ? "hand" : "rim";
+    const std::string what = kind_ == Kind::cut ? "hand" : "rim";
     metrics[what + "_offset_mean_over_time"] =
         special_samples ? all_special.mean / special_samples : 0.0;
     metrics[what + "_offset_max_over_time"] = worst_special.max;
     metrics["units"] = "metres: offset = distance of a node from its CGA-skinned target";
+    return metrics;
+  }
+
+  void add_plot(RunOutput& out) const {
+    const bool is_cut = kind_ == Kind::cut;
     out.add_plot({"offsets",
                   is_cut ? "cut: distance of nodes from their skinned targets"
                          : "drill: distance of nodes from their skinned targets",
@@ -283,9 +350,6 @@ class ArmEventScene : public Scene {
                                                    {"metrics.csv", "t", "rim_offset_max",
                                                     "hole rim (max)", "lines"}},
                   {}});
-    Json timings = {{"physics_ms_per_step", physics_ms / c.steps}, {"event_ms", event_ms}};
-    out.finish(resolved_, metrics, timings, c.steps, c.steps * c.dt, loop_s);
-    return metrics;
   }
 
  private:
@@ -391,8 +455,6 @@ class Character final : public Scene {
   bullet::Material material_;
 };
 
-}  // namespace
-
 std::unique_ptr<Scene> make_cut(const Json& scene, const std::string& name, int steps) {
   return std::make_unique<ArmEventScene>(ArmEventScene::Kind::cut, scene, name, steps);
 }
@@ -403,4 +465,20 @@ std::unique_ptr<Scene> make_character(const Json& scene, const std::string& name
   return std::make_unique<Character>(scene, name, steps);
 }
 
+const SceneRegistration kCutRegistration{
+    {"cut",
+     "a planar cut through the forearm of the moving soft arm; the pieces keep simulating under "
+     "gravity, the hand piece stays skinned to its bones",
+     kCutJson, &make_cut, 2}};
+const SceneRegistration kDrillRegistration{
+    {"drill",
+     "a hole drilled through the upper arm, then the arm moves; the hole's rim stays on the skin",
+     kDrillJson, &make_drill, 3}};
+const SceneRegistration kCharacterRegistration{
+    {"character",
+     "a real rigged model (assimp) plays its animation through CGA skinning with soft-body "
+     "secondary motion",
+     kCharacterJson, &make_character, 4}};
+
+}  // namespace
 }  // namespace conform::scenes

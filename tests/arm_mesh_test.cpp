@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <unordered_map>
 
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 
 namespace {
 

@@ -1,15 +1,51 @@
 #!/usr/bin/env bash
 # Installs the built project into a temporary prefix, builds tests/consumer against it with
-# find_package(Conform) and runs it. Arguments: <conform binary> <source dir> <build dir>.
+# find_package(Conform) and runs it. Checks what an application gets from the package: the
+# Bullet consumer (conform::core, conform::bullet) compiles without -fopenmp or any Conform
+# definition and links no assimp; the importer (conform::io) links assimp and reads a model;
+# no internal or detail/ header (other than cga's, which multivector.hpp needs) is installed.
+# Arguments: <conform binary> <source dir> <build dir>.
 set -euo pipefail
 source_dir="$2"
 build_dir="$3"
 work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
+fail() {
+  echo "install_test: $*" >&2
+  exit 1
+}
 cmake --install "$build_dir" --prefix "$work/prefix" >/dev/null
 double="$(grep -E '^CONFORM_DOUBLE:BOOL=' "$build_dir/CMakeCache.txt" | cut -d= -f2)"
+
+include="$work/prefix/include/conform"
+for internal in ik/kernel.hpp ik/kernel_q12.hpp io/crash_guard.hpp; do
+  [[ ! -e "$include/$internal" ]] || fail "internal header $internal is installed"
+done
+[[ -e "$include/ik/arm_ik.hpp" && -e "$include/bullet/plugin.hpp" ]] ||
+  fail "public headers are missing from the prefix"
+details="$(cd "$include" && find . -path '*/detail/*' ! -path './cga/detail/product_table.hpp')"
+[[ -z "$details" ]] || fail "detail headers are installed: $details"
+
 cmake -S "$source_dir/tests/consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" \
-  -DCMAKE_BUILD_TYPE=Release >/dev/null
+  -DCMAKE_BUILD_TYPE=Release -DCMAKE_EXPORT_COMPILE_COMMANDS=ON >/dev/null
 cmake --build "$work/build" >/dev/null
+
+# What the consumer was compiled and linked with.
+consumer_compile="$(grep -E '"command": .*main\.cpp' "$work/build/compile_commands.json" || true)"
+[[ -n "$consumer_compile" ]] || fail "no compile command for the consumer"
+if grep -qE -- '-fopenmp|CONFORM_VERSION' <<<"$consumer_compile"; then
+  fail "the consumer is compiled with flags of Conform's build: $consumer_compile"
+fi
+grep -qE -- '-std=(c|gnu)\+\+20' <<<"$consumer_compile" ||
+  fail "the consumer is not compiled as C++20 (cxx_std_20 not passed on)"
+if readelf -d "$work/build/consumer" | grep -q 'assimp'; then
+  fail "the Bullet consumer links assimp: $(readelf -d "$work/build/consumer" | grep assimp)"
+fi
+readelf -d "$work/build/importer" | grep -q 'assimp' || fail "the importer does not link assimp"
+
 "$work/build/consumer"
-echo "install_test: find_package(Conform) from $work/prefix works (CONFORM_DOUBLE=$double)"
+"$work/build/importer" arm
+model=/usr/share/assimp/models/OBJ/box.obj
+if [[ -r "$model" ]]; then "$work/build/importer" "$model"; fi
+echo "install_test: find_package(Conform) from $work/prefix works (CONFORM_DOUBLE=$double);" \
+  "the Bullet consumer links no assimp and compiles with no Conform flags"

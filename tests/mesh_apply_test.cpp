@@ -14,8 +14,8 @@
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/primitives.hpp"
-#include "conform/mesh/procedural_arm.hpp"
 #include "conform/mesh/topology_change.hpp"
+#include "conform/skin/procedural_arm.hpp"
 
 using namespace conform;
 using namespace conform::mesh;

@@ -14,7 +14,7 @@
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/primitives.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "skin_reference.hpp"
 
 using namespace conform;

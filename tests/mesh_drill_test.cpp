@@ -11,7 +11,7 @@
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/face_index.hpp"
 #include "conform/mesh/primitives.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "skin_reference.hpp"
 
 using namespace conform::mesh;

@@ -11,9 +11,9 @@
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/primitives.hpp"
-#include "conform/mesh/procedural_arm.hpp"
 #include "conform/mesh/refine.hpp"
 #include "conform/mesh/tear.hpp"
+#include "conform/skin/procedural_arm.hpp"
 
 using namespace conform::mesh;
 

@@ -11,8 +11,8 @@
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/face_index.hpp"
 #include "conform/mesh/primitives.hpp"
-#include "conform/mesh/procedural_arm.hpp"
 #include "conform/mesh/tear.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "skin_reference.hpp"
 
 using namespace conform;

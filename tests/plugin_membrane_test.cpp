@@ -7,7 +7,7 @@
 
 #include "conform/bullet/plugin.hpp"
 #include "conform/membrane/slit_sheet.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "plugin_world.hpp"
 
 namespace conform {

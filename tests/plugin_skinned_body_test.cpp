@@ -10,7 +10,7 @@
 #include "conform/io/import.hpp"
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/primitives.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 #include "plugin_world.hpp"
 

@@ -13,7 +13,7 @@
 
 #include "conform/bullet/plugin.hpp"
 #include "conform/mesh/analysis.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "plugin_world.hpp"
 
 using namespace conform;

@@ -3,8 +3,8 @@
 
 #include <numbers>
 
-#include "conform/mesh/procedural_arm.hpp"
 #include "conform/skin/animation.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 
 namespace {

@@ -5,8 +5,8 @@
 #include <numbers>
 #include <random>
 
-#include "conform/mesh/procedural_arm.hpp"
 #include "conform/skin/baselines.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 
 namespace {

@@ -11,7 +11,7 @@
 
 #include "conform/bullet/convert.hpp"
 #include "conform/bullet/plugin.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 
 int main() {
   // The application's own world.

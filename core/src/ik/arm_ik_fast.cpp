@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cstddef>
 #include <limits>
+#include <string>
+#include <utility>
 
 #include "conform/ik/arm_ik.hpp"
 #include "conform/ik/kernel.hpp"
@@ -367,19 +369,37 @@ CONFORM_IK_CLONES void run_range(const detail::KernelConstants<double>& c,
 }  // namespace
 
 template <class T>
-bool BatchSolveJob<T>::Validate() const {
-  if (!arm.valid() || arm.limits.has_cone()) return false;
+std::string BatchSolveJob<T>::validate() const {
+  if (!arm.valid())
+    return "arm: lengths " + std::to_string(arm.upper) + ", " + std::to_string(arm.fore) +
+           " or elbow range is invalid";
+  if (arm.limits.has_cone())
+    return "arm.limits.cone_half_angle: " + std::to_string(arm.limits.cone_half_angle) +
+           " (the batch does not honour a shoulder cone; use ArmIk)";
   const std::size_t n = x.size();
-  for (std::size_t s :
-       {y.size(), z.size(), swivel.size(), qs_w.size(), qs_x.size(), qs_y.size(), qs_z.size(),
-        qe_w.size(), qe_x.size(), elbow_x.size(), elbow_y.size(), elbow_z.size(), status.size()})
-    if (s != n) return false;
-  return threads >= 0;
+  const std::pair<const char*, std::size_t> sizes[] = {{"y", y.size()},
+                                                       {"z", z.size()},
+                                                       {"swivel", swivel.size()},
+                                                       {"qs_w", qs_w.size()},
+                                                       {"qs_x", qs_x.size()},
+                                                       {"qs_y", qs_y.size()},
+                                                       {"qs_z", qs_z.size()},
+                                                       {"qe_w", qe_w.size()},
+                                                       {"qe_x", qe_x.size()},
+                                                       {"elbow_x", elbow_x.size()},
+                                                       {"elbow_y", elbow_y.size()},
+                                                       {"elbow_z", elbow_z.size()},
+                                                       {"status", status.size()}};
+  for (const auto& [name, size] : sizes)
+    if (size != n)
+      return std::string(name) + ": size " + std::to_string(size) + ", x has " + std::to_string(n);
+  if (threads < 0) return "threads: " + std::to_string(threads) + " (must be >= 0)";
+  return {};
 }
 
 template <class T>
-bool BatchSolveJob<T>::Run() const {
-  if (!Validate()) return false;
+bool BatchSolveJob<T>::run() const {
+  if (!validate().empty()) return false;
   const auto c = constants(arm);
   const BatchPointers<T> p{x.data(),       y.data(),     z.data(),       swivel.data(),
                            qs_w.data(),    qs_x.data(),  qs_y.data(),    qs_z.data(),

@@ -13,7 +13,7 @@
 #include <unordered_map>
 
 #include "conform/io/crash_guard.hpp"
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 
 namespace conform::io {
@@ -143,6 +143,8 @@ struct Builder {
     return static_cast<std::int32_t>(model.skeleton.bones.size() - 1);
   }
 
+  // Every mesh of the scene into one SkinnedMesh: vertices, triangles and bone weights, each
+  // checked (indices in range, finite values, weights summing to 1).
   void meshes() {
     auto& mesh = model.mesh;
     std::size_t nv = 0, nf = 0;
@@ -161,7 +163,7 @@ struct Builder {
     if (all_normals) mesh.normals.resize(3, static_cast<Eigen::Index>(nv));
     if (all_uvs) mesh.uvs.resize(2, static_cast<Eigen::Index>(nv));
 
-    std::vector<std::vector<std::pair<std::int32_t, double>>> inf(nv);
+    Influences inf(nv);
     std::int32_t base = 0;
     std::size_t skipped = 0;
     for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
@@ -177,87 +179,114 @@ struct Builder {
         warn("mesh '" + info.name + "' is not referenced by any node; placed at the root");
         info.joint = 0;
       }
-      for (unsigned v = 0; v < am->mNumVertices; ++v) {
-        const aiVector3D& p = am->mVertices[v];
-        const Eigen::Vector3d x(p.x, p.y, p.z);
-        if (!x.allFinite())
-          fail("mesh '" + info.name + "' vertex " + std::to_string(v) + " is NaN or infinite");
-        mesh.rest.col(base + static_cast<std::int32_t>(v)) = x;
-        if (all_normals) {
-          const aiVector3D& n = am->mNormals[v];
-          mesh.normals.col(base + static_cast<std::int32_t>(v)) = Eigen::Vector3d(n.x, n.y, n.z);
-        }
-        if (all_uvs) {
-          const aiVector3D& t = am->mTextureCoords[0][v];
-          mesh.uvs.col(base + static_cast<std::int32_t>(v)) = Eigen::Vector2d(t.x, t.y);
-        }
-      }
-      for (unsigned f = 0; f < am->mNumFaces; ++f) {
-        const aiFace& face = am->mFaces[f];
-        if (face.mNumIndices != 3) {
-          ++skipped;
-          continue;
-        }
-        mesh::Face tri;
-        for (int k = 0; k < 3; ++k) {
-          if (face.mIndices[k] >= am->mNumVertices)
-            fail("mesh '" + info.name + "' face " + std::to_string(f) + " refers to vertex " +
-                 std::to_string(face.mIndices[k]) + " of " + std::to_string(am->mNumVertices));
-          tri[static_cast<std::size_t>(k)] = base + static_cast<std::int32_t>(face.mIndices[k]);
-        }
-        mesh.faces.push_back(tri);
-      }
+      vertices(am, info, base, all_normals, all_uvs);
+      skipped += triangles(am, info, base);
       info.face_count = static_cast<std::int32_t>(mesh.faces.size()) - info.first_face;
-
-      if (am->mNumBones == 0) {
-        const auto b = rigid_bone(info.joint);
-        for (unsigned v = 0; v < am->mNumVertices; ++v)
-          inf[static_cast<std::size_t>(base) + v].push_back({b, 1.0});
-      } else {
-        for (unsigned i = 0; i < am->mNumBones; ++i) {
-          const aiBone* ab = am->mBones[i];
-          const auto b = bone_for(ab, info.name);
-          for (unsigned k = 0; k < ab->mNumWeights; ++k) {
-            const aiVertexWeight& w = ab->mWeights[k];
-            if (w.mVertexId >= am->mNumVertices)
-              fail("bone '" + std::string(ab->mName.C_Str()) + "' of mesh '" + info.name +
-                   "' refers to vertex " + std::to_string(w.mVertexId) + " of " +
-                   std::to_string(am->mNumVertices));
-            if (!std::isfinite(w.mWeight) || w.mWeight < 0)
-              fail("bone '" + std::string(ab->mName.C_Str()) + "' of mesh '" + info.name +
-                   "' has a NaN, infinite or negative weight");
-            if (w.mWeight > 0)
-              inf[static_cast<std::size_t>(base) + w.mVertexId].push_back({b, w.mWeight});
-          }
-        }
-        // Weights must sum to 1. Exporters truncating to 4 influences without renormalizing
-        // leave sums a little below 1 (FBX/huesitos.fbx: 0.948–1); those are renormalized with
-        // a warning, anything further off is an error.
-        std::size_t off = 0;
-        double worst = 1;
-        for (unsigned v = 0; v < am->mNumVertices; ++v) {
-          auto& list = inf[static_cast<std::size_t>(base) + v];
-          double sum = 0;
-          for (const auto& bw : list) sum += bw.second;
-          if (std::abs(sum - 1) > options.weight_tolerance)
-            fail("the bone weights of vertex " + std::to_string(v) + " of mesh '" + info.name +
-                 "' sum to " + std::to_string(sum) + ", not 1");
-          if (std::abs(sum - 1) > 1e-4) {
-            ++off;
-            if (std::abs(sum - 1) > std::abs(worst - 1)) worst = sum;
-          }
-          for (auto& bw : list) bw.second /= sum;
-        }
-        if (off)
-          warn("mesh '" + info.name + "': the weights of " + std::to_string(off) +
-               " vertices do not sum to 1 (worst " + std::to_string(worst) + "); renormalized");
-      }
+      weights(am, info, base, inf);
       model.meshes.push_back(info);
       base += info.vertex_count;
     }
     if (skipped) warn(std::to_string(skipped) + " point or line primitives ignored");
     if (mesh.faces.empty()) fail("contains no triangles");
+    store_influences(inf, nv);
+  }
 
+  // Every vertex's bone influences, before the shared mesh keeps the 4 largest.
+  using Influences = std::vector<std::vector<std::pair<std::int32_t, double>>>;
+
+  void vertices(const aiMesh* am, const MeshInfo& info, std::int32_t base, bool all_normals,
+                bool all_uvs) {
+    auto& mesh = model.mesh;
+    for (unsigned v = 0; v < am->mNumVertices; ++v) {
+      const aiVector3D& p = am->mVertices[v];
+      const Eigen::Vector3d x(p.x, p.y, p.z);
+      if (!x.allFinite())
+        fail("mesh '" + info.name + "' vertex " + std::to_string(v) + " is NaN or infinite");
+      mesh.rest.col(base + static_cast<std::int32_t>(v)) = x;
+      if (all_normals) {
+        const aiVector3D& n = am->mNormals[v];
+        mesh.normals.col(base + static_cast<std::int32_t>(v)) = Eigen::Vector3d(n.x, n.y, n.z);
+      }
+      if (all_uvs) {
+        const aiVector3D& t = am->mTextureCoords[0][v];
+        mesh.uvs.col(base + static_cast<std::int32_t>(v)) = Eigen::Vector2d(t.x, t.y);
+      }
+    }
+  }
+
+  // The mesh's triangles, indices checked; returns how many other primitives were skipped.
+  std::size_t triangles(const aiMesh* am, const MeshInfo& info, std::int32_t base) {
+    auto& mesh = model.mesh;
+    std::size_t skipped = 0;
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) {
+        ++skipped;
+        continue;
+      }
+      mesh::Face tri;
+      for (int k = 0; k < 3; ++k) {
+        if (face.mIndices[k] >= am->mNumVertices)
+          fail("mesh '" + info.name + "' face " + std::to_string(f) + " refers to vertex " +
+               std::to_string(face.mIndices[k]) + " of " + std::to_string(am->mNumVertices));
+        tri[static_cast<std::size_t>(k)] = base + static_cast<std::int32_t>(face.mIndices[k]);
+      }
+      mesh.faces.push_back(tri);
+    }
+    return skipped;
+  }
+
+  // The mesh's bone weights (one rigid bone for a mesh without bones), checked and
+  // renormalized.
+  void weights(const aiMesh* am, const MeshInfo& info, std::int32_t base, Influences& inf) {
+    if (am->mNumBones == 0) {
+      const auto b = rigid_bone(info.joint);
+      for (unsigned v = 0; v < am->mNumVertices; ++v)
+        inf[static_cast<std::size_t>(base) + v].push_back({b, 1.0});
+    } else {
+      for (unsigned i = 0; i < am->mNumBones; ++i) {
+        const aiBone* ab = am->mBones[i];
+        const auto b = bone_for(ab, info.name);
+        for (unsigned k = 0; k < ab->mNumWeights; ++k) {
+          const aiVertexWeight& w = ab->mWeights[k];
+          if (w.mVertexId >= am->mNumVertices)
+            fail("bone '" + std::string(ab->mName.C_Str()) + "' of mesh '" + info.name +
+                 "' refers to vertex " + std::to_string(w.mVertexId) + " of " +
+                 std::to_string(am->mNumVertices));
+          if (!std::isfinite(w.mWeight) || w.mWeight < 0)
+            fail("bone '" + std::string(ab->mName.C_Str()) + "' of mesh '" + info.name +
+                 "' has a NaN, infinite or negative weight");
+          if (w.mWeight > 0)
+            inf[static_cast<std::size_t>(base) + w.mVertexId].push_back({b, w.mWeight});
+        }
+      }
+      // Weights must sum to 1. Exporters truncating to 4 influences without renormalizing
+      // leave sums a little below 1 (FBX/huesitos.fbx: 0.948–1); those are renormalized with
+      // a warning, anything further off is an error.
+      std::size_t off = 0;
+      double worst = 1;
+      for (unsigned v = 0; v < am->mNumVertices; ++v) {
+        auto& list = inf[static_cast<std::size_t>(base) + v];
+        double sum = 0;
+        for (const auto& bw : list) sum += bw.second;
+        if (std::abs(sum - 1) > options.weight_tolerance)
+          fail("the bone weights of vertex " + std::to_string(v) + " of mesh '" + info.name +
+               "' sum to " + std::to_string(sum) + ", not 1");
+        if (std::abs(sum - 1) > 1e-4) {
+          ++off;
+          if (std::abs(sum - 1) > std::abs(worst - 1)) worst = sum;
+        }
+        for (auto& bw : list) bw.second /= sum;
+      }
+      if (off)
+        warn("mesh '" + info.name + "': the weights of " + std::to_string(off) +
+             " vertices do not sum to 1 (worst " + std::to_string(worst) + "); renormalized");
+    }
+  }
+
+  // The influence lists, and the shared mesh's 4 largest (renormalized, sorted decreasing).
+  void store_influences(const Influences& inf, std::size_t nv) {
+    auto& mesh = model.mesh;
     auto& lists = model.influences;
     lists.offsets.assign(1, 0);
     for (const auto& v : inf) {

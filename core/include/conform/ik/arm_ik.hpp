@@ -25,17 +25,77 @@
 // per thread for the last arm it saw.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numbers>
 #include <span>
 #include <string>
 
 #include "conform/cga/motor.hpp"
 #include "conform/cga/point.hpp"
-#include "conform/ik/kernel.hpp"
 
 namespace conform::ik {
+
+namespace detail {
+
+/// Per-arm constants, computed once per ArmIk or batch (the free solve() keeps the last ones).
+template <class T>
+struct KernelConstants {
+  T d1;
+  T reach_max, reach_min;    // clamp range of |Pw| (elbow limits included)
+  T reach_max2, reach_min2;  // the same for |Pw|²
+  T geo_max, geo_min;        // d1 + d2, |d1 − d2| (what is reachable at all)
+  T sum2, diff2;             // (d1 + d2)², (d1 − d2)²
+  T dd;                      // (d1 − d2)(d1 + d2), accurate when d1 ≈ d2
+  T k2;                      // 1 / (4 d1 d2)
+  T half_inv_d1;             // 1 / (2 d1)
+  T two_d2;                  // 2 d2
+  T tiny, tiny2;             // |Pw| below this is "at the shoulder"; its square
+  T inv_reach_max, inv_reach_min;
+  bool limit_max, limit_min;  // the elbow range narrows reach_max / reach_min
+  T axis_tol2;                // (64 ε)²: squared sine of the angle to the z axis
+
+  static KernelConstants make(double d1, double d2, double flex_min, double flex_max) {
+    KernelConstants c{};
+    c.d1 = T(d1);
+    const double sum = d1 + d2, diff = d1 - d2;
+    c.geo_max = T(sum), c.geo_min = T(std::abs(diff));
+    // |Pw|² as a function of the flexion θ: (d1+d2)² − 4 d1 d2 sin²(θ/2)
+    // = (d1−d2)² + 4 d1 d2 cos²(θ/2), each written where it has no cancellation.
+    c.limit_max = flex_min > 0;
+    c.limit_min = flex_max < std::numbers::pi;
+    double lmax2 = sum * sum, lmin2 = diff * diff;
+    if (c.limit_max) {
+      const double s = std::sin(flex_min / 2);
+      lmax2 -= 4 * d1 * d2 * s * s;
+    }
+    if (c.limit_min) {
+      const double co = std::cos(flex_max / 2);
+      lmin2 += 4 * d1 * d2 * co * co;
+    }
+    const double tiny = 64 * std::numeric_limits<T>::epsilon() * sum;
+    const double lmax = c.limit_max ? std::sqrt(lmax2) : sum;
+    const double lmin = std::max(c.limit_min ? std::sqrt(lmin2) : std::abs(diff), tiny);
+    c.reach_max = T(lmax), c.reach_min = T(lmin);
+    c.reach_max2 = T(lmax2), c.reach_min2 = T(std::max(lmin2, tiny * tiny));
+    c.sum2 = T(sum * sum), c.diff2 = T(diff * diff);
+    c.dd = T(diff * sum);
+    c.k2 = T(0.25 / (d1 * d2));
+    c.half_inv_d1 = T(0.5 / d1);
+    c.two_d2 = T(2 * d2);
+    c.tiny = T(tiny);
+    c.tiny2 = T(tiny * tiny);
+    c.inv_reach_max = T(1) / c.reach_max;
+    c.inv_reach_min = T(1) / c.reach_min;
+    const double tol = 64 * std::numeric_limits<T>::epsilon();
+    c.axis_tol2 = T(tol * tol);
+    return c;
+  }
+};
+
+}  // namespace detail
 
 template <class T>
 using Vec3 = cga::Vec3<T>;
@@ -169,7 +229,7 @@ Solution<T> solve_readable(const Arm<T>& arm, const Vec3<T>& target, T swivel);
 
 /// Many targets for one arm, structure of arrays (ozz-style job: owns no buffers).
 /// Every span must have the size of `x`. Qe is returned as qe_w + qe_x i (its y, z are 0).
-/// The elbow range limit is honoured; the shoulder cone is not (Validate() rejects it).
+/// The elbow range limit is honoured; the shoulder cone is not (validate() rejects it).
 template <class T>
 struct BatchSolveJob {
   Arm<T> arm;
@@ -180,9 +240,13 @@ struct BatchSolveJob {
   std::span<std::uint8_t> status;  // Status bits
   int threads = 0;                 // OpenMP threads; 0 = OpenMP's default, 1 = this thread only
 
-  bool Validate() const;
-  /// Runs the job; false (and nothing written) when Validate() fails.
-  bool Run() const;
+  /// Empty when the job can run; else the first bad input, named with its value.
+  std::string validate() const;
+  /// Runs the job; false (and nothing written) when validate() is not empty.
+  bool run() const;
+  /// The first spelling of the same pair (ozz's), kept for existing callers.
+  bool Validate() const { return validate().empty(); }
+  bool Run() const { return run(); }
 };
 
 extern template struct BatchSolveJob<float>;

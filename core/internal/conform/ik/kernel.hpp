@@ -1,6 +1,8 @@
 // The closed-form IK kernel shared by the scalar solvers and the SIMD batch: no library
 // calls, and in the vector path branch-free (every choice is a select), so that
-// `#pragma omp simd` loops vectorize it. Internal: use conform/ik/arm_ik.hpp.
+// `#pragma omp simd` loops vectorize it. Internal (not installed): use conform/ik/arm_ik.hpp.
+// The per-arm constants it reads, detail::KernelConstants, are in arm_ik.hpp (ArmIk keeps
+// them by value).
 //
 // It is eqs 10–18 of the first paper re-derived from the geometry, with Qs taken from the
 // upper arm's frame instead of the paper's product Q12·Q3. With P̂ = Pw/L, L = |Pw| (clamped
@@ -34,6 +36,8 @@
 #include <limits>
 #include <numbers>
 #include <type_traits>
+
+#include "conform/ik/arm_ik.hpp"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -143,61 +147,6 @@ template <class T>
   const T a = kCos[r.q & 3], b = kSin[r.q & 3];
   return {r.s * a + r.c * b, r.c * a - r.s * b};
 }
-
-/// Per-arm constants, computed once per ArmIk or batch (the free solve() keeps the last ones).
-template <class T>
-struct KernelConstants {
-  T d1;
-  T reach_max, reach_min;    // clamp range of |Pw| (elbow limits included)
-  T reach_max2, reach_min2;  // the same for |Pw|²
-  T geo_max, geo_min;        // d1 + d2, |d1 − d2| (what is reachable at all)
-  T sum2, diff2;             // (d1 + d2)², (d1 − d2)²
-  T dd;                      // (d1 − d2)(d1 + d2), accurate when d1 ≈ d2
-  T k2;                      // 1 / (4 d1 d2)
-  T half_inv_d1;             // 1 / (2 d1)
-  T two_d2;                  // 2 d2
-  T tiny, tiny2;             // |Pw| below this is "at the shoulder"; its square
-  T inv_reach_max, inv_reach_min;
-  bool limit_max, limit_min;  // the elbow range narrows reach_max / reach_min
-  T axis_tol2;                // (64 ε)²: squared sine of the angle to the z axis
-
-  static KernelConstants make(double d1, double d2, double flex_min, double flex_max) {
-    KernelConstants c{};
-    c.d1 = T(d1);
-    const double sum = d1 + d2, diff = d1 - d2;
-    c.geo_max = T(sum), c.geo_min = T(std::abs(diff));
-    // |Pw|² as a function of the flexion θ: (d1+d2)² − 4 d1 d2 sin²(θ/2)
-    // = (d1−d2)² + 4 d1 d2 cos²(θ/2), each written where it has no cancellation.
-    c.limit_max = flex_min > 0;
-    c.limit_min = flex_max < std::numbers::pi;
-    double lmax2 = sum * sum, lmin2 = diff * diff;
-    if (c.limit_max) {
-      const double s = std::sin(flex_min / 2);
-      lmax2 -= 4 * d1 * d2 * s * s;
-    }
-    if (c.limit_min) {
-      const double co = std::cos(flex_max / 2);
-      lmin2 += 4 * d1 * d2 * co * co;
-    }
-    const double tiny = 64 * std::numeric_limits<T>::epsilon() * sum;
-    const double lmax = c.limit_max ? std::sqrt(lmax2) : sum;
-    const double lmin = std::max(c.limit_min ? std::sqrt(lmin2) : std::abs(diff), tiny);
-    c.reach_max = T(lmax), c.reach_min = T(lmin);
-    c.reach_max2 = T(lmax2), c.reach_min2 = T(std::max(lmin2, tiny * tiny));
-    c.sum2 = T(sum * sum), c.diff2 = T(diff * diff);
-    c.dd = T(diff * sum);
-    c.k2 = T(0.25 / (d1 * d2));
-    c.half_inv_d1 = T(0.5 / d1);
-    c.two_d2 = T(2 * d2);
-    c.tiny = T(tiny);
-    c.tiny2 = T(tiny * tiny);
-    c.inv_reach_max = T(1) / c.reach_max;
-    c.inv_reach_min = T(1) / c.reach_min;
-    const double tol = 64 * std::numeric_limits<T>::epsilon();
-    c.axis_tol2 = T(tol * tol);
-    return c;
-  }
-};
 
 // Select-based min/max (fmin/fmax do not vectorize without -ffast-math).
 template <class T>

@@ -1,4 +1,4 @@
-#include "conform/mesh/procedural_arm.hpp"
+#include "conform/skin/procedural_arm.hpp"
 
 #include <algorithm>
 #include <cmath>

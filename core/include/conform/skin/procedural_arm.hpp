@@ -18,6 +18,9 @@
 // Bones (the skeleton's joints and bones share indices): 0 shoulder (moves the upper arm),
 // 1 elbow (forearm), 2 wrist (hand). Weights blend smoothly (smoothstep of z) across
 // ±4 cm of the elbow and ±3 cm of the wrist; elsewhere a vertex follows one bone.
+//
+// A rigged model (mesh + skeleton), so it sits in the skin layer, above mesh; its names stay in
+// conform::mesh, where every caller already finds them.
 #pragma once
 
 #include <cstdint>
