@@ -1,5 +1,7 @@
 #include "conform/mesh/topology_change.hpp"
 
+#include "conform/mesh/detail/apply_steps.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -106,9 +108,11 @@ void apply(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency
     throw std::invalid_argument("apply: the adjacency does not describe this mesh");
   if (const std::string problem = change.validate(); !problem.empty())
     throw std::invalid_argument("apply: " + problem);
-  apply_vertices(mesh, change);
-  apply_faces(mesh, change, adjacency);
+  detail::apply_vertices(mesh, change);
+  detail::apply_faces(mesh, change, adjacency);
 }
+
+namespace detail {
 
 void apply_vertices(SkinnedMesh& mesh, const TopologyChange& change) {
   // Vertices: grow every per-vertex array, then fill the new columns in order (a new vertex may
@@ -189,5 +193,7 @@ void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adj
   };
   visit_face_slots(change, Slots{mesh, adjacency, added, filled});
 }
+
+}  // namespace detail
 
 }  // namespace conform::mesh

@@ -72,11 +72,6 @@ struct TopologyChange {
 /// change does not validate or was computed for a mesh of other counts.
 void apply(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency = nullptr);
 
-/// The two halves of apply(), without its validation, for timing them separately (weights
-/// and attributes of the new vertices; face slots). apply_vertices must run first.
-void apply_vertices(SkinnedMesh& mesh, const TopologyChange& change);
-void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency);
-
 /// The face-slot rule (steps 1–3 above), written once for every copy of the faces that has to
 /// follow a change: the mesh (apply), FaceIndex::update, face_after, added_face_indices, the
 /// plugin's soft body. Calls, in order,
