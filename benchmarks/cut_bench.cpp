@@ -39,6 +39,8 @@
 
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/cut.hpp"
+#include "conform/mesh/detail/apply_steps.hpp"
+#include "conform/mesh/detail/cut_predicates.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "mesh_bench_util.hpp"
 
@@ -223,12 +225,12 @@ void cgal_clip_bench(benchmark::State& state, int faces, bool cap) {
 // Table 1, subroutine 1: vertex classification.
 void table1_sub1(benchmark::State& state, bool euclidean) {
   const Model& m = model(0);
-  const auto p = euclidean ? Predicates::Euclidean : Predicates::Cga;
+  const auto p = euclidean ? detail::Predicates::Euclidean : detail::Predicates::Cga;
   std::vector<double> d;
   double total = 0;
   for (auto _ : state) {
     total += timed(state, [&] {
-      classify_vertices(m.mesh, kCutPlane, p, d);
+      detail::classify_vertices(m.mesh, kCutPlane, p, d);
       benchmark::DoNotOptimize(d.data());
     });
   }
@@ -240,11 +242,11 @@ void table1_sub1(benchmark::State& state, bool euclidean) {
 // Sub1 row measures that part separately).
 void table1_sub2(benchmark::State& state, bool euclidean) {
   const Model& m = model(0);
-  const CutOptions o{.predicates = euclidean ? Predicates::Euclidean : Predicates::Cga};
+  const auto p = euclidean ? detail::Predicates::Euclidean : detail::Predicates::Cga;
   double total = 0;
   for (auto _ : state) {
     total += timed(state, [&] {
-      CutResult r = compute_cut(m.mesh, kCutPlane, o);
+      CutResult r = detail::compute_cut(m.mesh, kCutPlane, {}, p);
       benchmark::DoNotOptimize(r.change.added_faces.data());
     });
   }
@@ -259,7 +261,7 @@ void table1_sub3(benchmark::State& state) {
   double total = 0;
   for (auto _ : state) {
     SkinnedMesh mesh = m.mesh;
-    total += timed(state, [&] { apply_vertices(mesh, r.change); });
+    total += timed(state, [&] { detail::apply_vertices(mesh, r.change); });
     benchmark::DoNotOptimize(mesh.weights.data());
   }
   state.counters["new_vertices"] = static_cast<double>(r.change.new_vertices.size());
@@ -271,13 +273,13 @@ void table1_sub4(benchmark::State& state) {
   const Model& m = model(0);
   const CutResult r = compute_cut(m.mesh, kCutPlane);
   SkinnedMesh with_vertices = m.mesh;
-  apply_vertices(with_vertices, r.change);
+  detail::apply_vertices(with_vertices, r.change);
   double total = 0;
   for (auto _ : state) {
     SkinnedMesh mesh = with_vertices;
     Adjacency adjacency = m.adjacency;
     total += timed(state, [&] {
-      apply_faces(mesh, r.change, &adjacency);
+      detail::apply_faces(mesh, r.change, &adjacency);
       const Pieces p = label_pieces(mesh);
       benchmark::DoNotOptimize(p.count);
     });

@@ -6,7 +6,7 @@
 // Every operation runs in two modes, in the same process (the signatures without an index
 // scan too: for one query a scan is cheaper than building an index):
 //   index — through a FaceIndex kept in sync (built once per mesh state, outside the timing);
-//   scan  — FaceSearch::Scan, one scan of every face (the former behaviour);
+//   scan  — no index: one scan of every face (the former behaviour);
 // and the run ends with the ratios index / scan of the median times.
 // BM_Index* time the index's own upkeep (build, refit) and one segment query against a scan.
 //
@@ -89,12 +89,10 @@ struct Work {
   }
   Tear tear(int mode) {
     TearOptions o;
-    o.search = mode == 1 ? FaceSearch::Scan : FaceSearch::Index;
     return mode == 0 ? Tear(mesh, adjacency, index, o) : Tear(mesh, adjacency, o);
   }
   DrillResult drill(int mode, const DrillTool& tool, bool tube, double rings = 0) {
     DrillOptions o;
-    o.search = mode == 1 ? FaceSearch::Scan : FaceSearch::Index;
     o.tube = tube;
     o.tube_ring_spacing = rings;
     return mode == 0 ? conform::mesh::drill(mesh, adjacency, index, tool, o)

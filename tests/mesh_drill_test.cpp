@@ -344,8 +344,8 @@ TEST(Drill, TubeOnlyJoinsEntryAndExit) {
 }
 
 TEST(Drill, IndexScanAndNoIndexAgree) {
-  // The same drill through the kept index, without an index and by FaceSearch::Scan: identical
-  // changes.
+  // The same drill through the kept index and without an index (by a scan; modes 1 and 2, as
+  // when the scan was an option): identical changes.
   const SkinnedMesh arm = make_arm(1).mesh;
   const DrillTool tool{{0.01, -0.2, 0.4}, {-0.01, 0.2, 0.43}, 0.009};
   std::vector<SkinnedMesh> out;
@@ -354,7 +354,6 @@ TEST(Drill, IndexScanAndNoIndexAgree) {
     Adjacency adj(m);
     DrillOptions o;
     o.tube = true;
-    o.search = mode == 2 ? FaceSearch::Scan : FaceSearch::Index;
     FaceIndex index(m);
     const DrillResult d = mode == 0 ? drill(m, adj, index, tool, o) : drill(m, adj, tool, o);
     EXPECT_EQ(d.tubes, 1) << mode << d.message;

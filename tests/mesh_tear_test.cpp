@@ -231,8 +231,9 @@ TEST(Tear, ReDeformation) {
 }
 
 TEST(Tear, IndexScanAndNoIndexStartAlike) {
-  // The tear through a kept FaceIndex, without an index and by FaceSearch::Scan makes the same
-  // changes; the kept index stays in sync (sound, and it answers as the scan does).
+  // The tear through a kept FaceIndex and without an index (by a scan; modes 1 and 2, as when
+  // the scan was an option) makes the same changes; the kept index stays in sync (sound, and it
+  // answers as the scan does).
   const SkinnedMesh in = make_arm(1).mesh;
   std::vector<SkinnedMesh> out;
   for (int mode = 0; mode < 3; ++mode) {
@@ -240,7 +241,6 @@ TEST(Tear, IndexScanAndNoIndexStartAlike) {
     Adjacency adj(m);
     FaceIndex index(m);
     TearOptions o;
-    o.search = mode == 2 ? FaceSearch::Scan : FaceSearch::Index;
     Tear tear = mode == 0 ? Tear(m, adj, index, o) : Tear(m, adj, o);
     // The first samples miss the arm (the blade stops short of it): no start, no change.
     for (int i = 0; i < 3; ++i)

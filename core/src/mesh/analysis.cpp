@@ -5,6 +5,8 @@
 #include <numeric>
 #include <tuple>
 
+#include "conform/mesh/detail/union_find.hpp"
+
 namespace conform::mesh {
 
 namespace {
@@ -16,15 +18,6 @@ void for_faces(const SkinnedMesh& mesh, std::span<const std::int32_t> faces, Fn 
   } else {
     for (auto i : faces) fn(mesh.faces[static_cast<std::size_t>(i)]);
   }
-}
-
-std::int32_t find_root(std::vector<std::int32_t>& parent, std::int32_t x) {
-  while (parent[static_cast<std::size_t>(x)] != x) {
-    parent[static_cast<std::size_t>(x)] =
-        parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
-    x = parent[static_cast<std::size_t>(x)];
-  }
-  return x;
 }
 
 }  // namespace
@@ -156,10 +149,10 @@ MeshReport check_mesh(const SkinnedMesh& mesh, double min_area) {
         bool shared = false;
         for (auto x : a)
           if (x != v && (x == c[0] || x == c[1] || x == c[2])) shared = true;
-        if (shared) parent[static_cast<std::size_t>(find_root(parent, i))] = find_root(parent, j);
+        if (shared) detail::unite(parent.data(), i, j);
       }
     int groups = 0;
-    for (std::int32_t i = 0; i < n; ++i) groups += find_root(parent, i) == i;
+    for (std::int32_t i = 0; i < n; ++i) groups += detail::find_root(parent.data(), i) == i;
     if (groups > 1) ++r.nonmanifold_vertices;
   }
   return r;
@@ -184,16 +177,7 @@ Pieces label_pieces(const SkinnedMesh& mesh) {
   if (parent.size() < nv) parent.resize(nv), label.resize(nv);
   std::int32_t* const par = parent.data();
   std::iota(par, par + nv, 0);
-  auto find = [par](std::int32_t x) {
-    for (;;) {
-      const std::int32_t p = par[x];
-      if (p == x) return x;
-      const std::int32_t g = par[p];
-      if (g == p) return p;  // the usual case: no write
-      par[x] = g;
-      x = g;
-    }
-  };
+  auto find = [par](std::int32_t x) { return detail::find_root(par, x); };
   for (const Face& f : mesh.faces) {
     // Three independent loads settle the usual face, whose vertices already share a parent.
     const std::int32_t p0 = par[f[0]];

@@ -443,7 +443,6 @@ void FaceIndex::rename(std::int32_t from, std::int32_t to) {
 void FaceIndex::update(const SkinnedMesh& mesh, const TopologyChange& change) {
   const auto& removed = change.removed_faces;
   const auto& added = change.added_faces;
-  const std::size_t filled = std::min(removed.size(), added.size());
   const auto final_count = static_cast<std::int64_t>(change.base_face_count) +
                            static_cast<std::int64_t>(added.size()) -
                            static_cast<std::int64_t>(removed.size());
@@ -451,8 +450,7 @@ void FaceIndex::update(const SkinnedMesh& mesh, const TopologyChange& change) {
     throw std::invalid_argument(
         "FaceIndex::update: the change was not computed for the indexed mesh (apply it first)");
   // Faces are tracked by slot. The removed faces leave first; then the slot bookkeeping of
-  // apply() is replayed (refilled slots, appended slots, then swap-with-last, where a moved
-  // face keeps its leaf under its new slot), and only then do the added faces enter, at their
+  // apply() is replayed (visit_face_slots), and only then do the added faces enter, at their
   // final slots, so that their positions are read from the changed mesh.
   const std::size_t nr = removed.size(), na = added.size();
   std::vector<std::int32_t> old_leaf(nr);
@@ -460,30 +458,20 @@ void FaceIndex::update(const SkinnedMesh& mesh, const TopologyChange& change) {
     old_leaf[j] = hint_of(removed[j]);
     erase(removed[j]);
   }
-  std::vector<std::int32_t> slot_of(na);
-  EdgeMap holder;  // (0, slot) → the added face in it, for refilled slots
-  for (std::size_t k = 0; k < filled; ++k) {
-    slot_of[k] = removed[k];
-    holder.insert(0, removed[k], static_cast<std::int32_t>(k));
-  }
-  for (std::size_t k = filled; k < na; ++k) {
-    slot_of[k] = static_cast<std::int32_t>(leaf_of_.size());
-    leaf_of_.push_back(-1);
-  }
-  for (std::size_t k = nr; k-- > filled;) {
-    const std::int32_t slot = removed[k];
-    const std::int32_t last = face_count() - 1;
-    if (slot != last) {
-      const std::int32_t h = holder.find(0, last);
-      if (h >= 0) {
-        slot_of[static_cast<std::size_t>(h)] = slot;
-        holder.insert(0, slot, h, true);
-      } else {
-        rename(last, slot);
-      }
+  struct Slots {
+    FaceIndex& index;
+    std::vector<std::int32_t> slot_of;
+    void fill(std::int32_t slot, std::size_t k) { slot_of[k] = slot; }
+    void append(std::int32_t slot, std::size_t k) {
+      slot_of[k] = slot;
+      index.leaf_of_.push_back(-1);
     }
-    leaf_of_.pop_back();
-  }
+    // The moved face is a base face (visit_face_slots): it keeps its leaf under its new slot.
+    void move(std::int32_t last, std::int32_t slot) { index.rename(last, slot); }
+    void pop(std::int32_t) { index.leaf_of_.pop_back(); }
+  } slots{*this, std::vector<std::int32_t>(na)};
+  visit_face_slots(change, slots);
+  const std::vector<std::int32_t>& slot_of = slots.slot_of;
   // The operations list added faces in the order of the faces they replace, so the k-th added
   // face most likely lies where removed face k·R/A lay: it enters the tree from that face's
   // leaf (and stays there when the leaf's box holds it).

@@ -1,6 +1,7 @@
 #include "conform/mesh/refine.hpp"
 
 #include <algorithm>
+#include <utility>
 
 namespace conform::mesh {
 
@@ -70,14 +71,15 @@ TopologyChange split_edges(const SkinnedMesh& mesh, const Adjacency& adjacency,
 }
 
 std::vector<std::int32_t> added_face_indices(const TopologyChange& change) {
-  std::vector<std::int32_t> out;
-  const std::size_t filled = std::min(change.removed_faces.size(), change.added_faces.size());
-  for (std::size_t k = 0; k < change.added_faces.size(); ++k)
-    out.push_back(k < filled ? change.removed_faces[k]
-                             : change.base_face_count + static_cast<std::int32_t>(k - filled));
-  // Step 3 of apply() only moves faces from the end into slots above every filled slot, so
-  // the added faces keep these indices.
-  return out;
+  struct Collect {
+    std::vector<std::int32_t> out;
+    void fill(std::int32_t slot, std::size_t) { out.push_back(slot); }
+    void append(std::int32_t slot, std::size_t) { out.push_back(slot); }
+    void move(std::int32_t, std::int32_t) {}  // never an added face (visit_face_slots)
+    void pop(std::int32_t) {}
+  } collect;
+  visit_face_slots(change, collect);
+  return std::move(collect.out);
 }
 
 }  // namespace conform::mesh

@@ -9,6 +9,7 @@
 
 #include "conform/cga/plane.hpp"
 #include "conform/mesh/analysis.hpp"
+#include "quad_split.hpp"
 
 namespace conform::mesh {
 
@@ -59,14 +60,6 @@ std::vector<std::int32_t> fan(const Adjacency& adj, std::int32_t h) {
     out.push_back(g);
   }
   return out;
-}
-
-// The quad (a, b, c, d) split along the diagonal (a, c) or (b, d), whichever gives the larger
-// smallest angle (the first on a tie).
-bool first_diagonal(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                    const Eigen::Vector3d& d) {
-  return std::min(smallest_angle_sin2(a, b, c), smallest_angle_sin2(a, c, d)) >=
-         std::min(smallest_angle_sin2(a, b, d), smallest_angle_sin2(b, c, d));
 }
 
 // The edge parameters t (from x to y) at which a point of edge (x, y) is seen from the vertex
@@ -131,6 +124,496 @@ std::array<double, 3> place_tip(const std::array<double, 3>& bary, const Eigen::
 
 }  // namespace
 
+// One sample of Tear::advance after the start: steps 1–3 of tear.hpp over the tear's state.
+// Each step is one member; what they hand on (the plane, the path, the new points) is below.
+class TearAdvance {
+ public:
+  TearAdvance(Tear& tear, const ScalpelSample& s, TearStep& step)
+      : tear_(tear),
+        mesh_(tear.mesh_),
+        adjacency_(tear.adjacency_),
+        s_(s),
+        step_(step),
+        snap_(tear.options_.snap_fraction) {}
+
+  void run() {
+    if (!make_plane()) return;
+    if (!walk()) return;
+    if (!split_along_path()) return;
+    open_left_side();
+    record();
+  }
+
+ private:
+  // Candidate first moves from a vertex: (face, exit, cosine).
+  struct Move {
+    std::int32_t face;
+    PathPoint out;
+    double cosine;
+  };
+
+  // Step 1: the plane Π through the tip and the blade, and the direction to walk in (toward
+  // the blade's point nearest the tip).
+  bool make_plane() {
+    tip_ = mesh_.current.col(tear_.tip_);
+    const auto plane = cga::Plane<double>::through(tip_, s_.a, s_.b);
+    if (!plane) {
+      tear_.message_ = "the blade is collinear with the tip: no plane";
+      return false;
+    }
+    plane_ = *plane;
+    n_ = plane_.normal();
+    const double scale = std::max({(s_.a - tip_).norm(), (s_.b - tip_).norm(), 1e-300});
+    zero_ = 1e-12 * scale;
+    const Eigen::Vector3d ab = s_.b - s_.a;
+    const double u =
+        std::clamp((tip_ - s_.a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+    toward_ = s_.a + u * ab - tip_;
+    return true;
+  }
+
+  double delta(std::int32_t v) const {
+    const double d = plane_.signed_distance(mesh_.current.col(v));
+    return std::abs(d) <= zero_ ? 0.0 : d;
+  }
+  Eigen::Vector3d pos(const PathPoint& p, std::int32_t face) const {
+    if (p.kind == PathPoint::Vertex) return mesh_.current.col(p.v);
+    if (p.kind == PathPoint::Edge)
+      return (1 - p.t) * mesh_.current.col(p.a) + p.t * mesh_.current.col(p.b);
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    return p.bary[0] * mesh_.current.col(f[0]) + p.bary[1] * mesh_.current.col(f[1]) +
+           p.bary[2] * mesh_.current.col(f[2]);
+  }
+  // The blade crosses `face`: `out` is the hit, kept snap_fraction inside the face.
+  bool blade_hit(std::int32_t face, PathPoint& out) const {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    std::array<double, 3> bary{};
+    if (!segment_triangle(s_.a, s_.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
+                          mesh_.current.col(f[2]), bary))
+      return false;
+    for (auto& x : bary) x = std::max(x, snap_);
+    const double sum = bary[0] + bary[1] + bary[2];
+    for (auto& x : bary) x /= sum;
+    out.kind = PathPoint::Inside;
+    out.bary = bary;
+    return true;
+  }
+  // A crossing of edge (x, y) at t from x, off Π if need be, into the range where it makes no
+  // sliver on either side.
+  PathPoint edge_point(std::int32_t x, std::int32_t y, double t) const {
+    const auto [lo, hi] = safe_range(mesh_, adjacency_, x, y, tear_.options_.min_angle);
+    t = std::clamp(t, std::max(lo, snap_), std::max(std::min(hi, 1 - snap_), std::max(lo, snap_)));
+    return {PathPoint::Edge, -1, x, y, t};
+  }
+  // Where Π leaves face `face` through the edge opposite its corner `corner` (x = next,
+  // y = after): a vertex, or a point on the edge; false when Π does not cross that edge.
+  bool exit_opposite(std::int32_t face, int corner, PathPoint& out) const {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    const std::int32_t x = f[(corner + 1) % 3], y = f[(corner + 2) % 3];
+    const double dx = delta(x), dy = delta(y);
+    if (dx == 0) return out = {PathPoint::Vertex, x}, true;
+    if (dy == 0) return out = {PathPoint::Vertex, y}, true;
+    if (!(dx * dy < 0)) return false;
+    const double t = dx / (dx - dy);
+    if (t < snap_) return out = {PathPoint::Vertex, x}, true;
+    if (t > 1 - snap_) return out = {PathPoint::Vertex, y}, true;
+    out = edge_point(x, y, t);
+    return true;
+  }
+  // The moves out of vertex v across the faces around it (found from any neighbour), best
+  // aligned with `dir` first; `fan_faces` gets those faces.
+  std::vector<Move> moves_from(std::int32_t v, std::int32_t any_neighbor,
+                               const Eigen::Vector3d& dir,
+                               std::vector<std::int32_t>& fan_faces) const {
+    std::vector<Move> moves;
+    std::int32_t h = adjacency_.find(v, any_neighbor);
+    if (h < 0) {
+      const std::int32_t g = adjacency_.find(any_neighbor, v);
+      if (g < 0) return moves;
+      h = 3 * (g / 3) + (g % 3 + 1) % 3;
+    }
+    fan_faces.clear();
+    for (auto he : fan(adjacency_, h)) {
+      const std::int32_t face = he / 3;
+      fan_faces.push_back(face);
+      PathPoint out;
+      if (!exit_opposite(face, he % 3, out)) continue;
+      const Eigen::Vector3d e = pos(out, face) - mesh_.current.col(v);
+      const double len = e.norm() * dir.norm();
+      moves.push_back({face, out, len > 0 ? e.dot(dir) / len : -1});
+    }
+    std::sort(moves.begin(), moves.end(),
+              [](const Move& a, const Move& b) { return a.cosine > b.cosine; });
+    return moves;
+  }
+  std::int32_t corner_of(std::int32_t face, std::int32_t v) const {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    return f[0] == v ? 0 : (f[1] == v ? 1 : 2);
+  }
+
+  // Step 2: walk from the tip along Π ∩ M; the first candidate direction that reaches the
+  // blade gives the path.
+  bool walk() {
+    // Any neighbour of the tip: the vertices of a face holding it, found through the last
+    // path point or the start face.
+    const auto& path = tear_.path_;
+    const std::int32_t tip = tear_.tip_;
+    std::int32_t neighbor = path.size() >= 2 ? path[path.size() - 2].right : -1;
+    if (neighbor < 0 || (adjacency_.find(tip, neighbor) < 0 && adjacency_.find(neighbor, tip) < 0))
+      neighbor = tear_.tip_neighbor_;
+    std::vector<std::int32_t> fan_faces;
+    const std::vector<Move> first = moves_from(tip, neighbor, toward_, fan_faces);
+    if (blade_next_to_tip(fan_faces)) {
+      tear_.message_ = "the blade has not moved away from the tip";
+      return false;
+    }
+    for (const Move& m : first) {
+      if (!path_.empty()) break;
+      if (m.cosine <= 0) break;
+      walk_from(m);
+    }
+    if (path_.empty()) {
+      tear_.message_ =
+          "the walk from the tip did not reach the blade (outside the mesh, unmoved, or past a "
+          "boundary)";
+      return false;
+    }
+    return true;
+  }
+
+  // The blade meets a face around the tip: the path is that one face, unless the blade is
+  // where it was (true: nothing to tear yet).
+  bool blade_next_to_tip(const std::vector<std::int32_t>& fan_faces) {
+    for (auto face : fan_faces) {
+      PathPoint hit;
+      if (!blade_hit(face, hit)) continue;
+      const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+      const double size = (mesh_.current.col(f[1]) - mesh_.current.col(f[0])).norm();
+      std::array<double, 3> raw{};
+      segment_triangle(s_.a, s_.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
+                       mesh_.current.col(f[2]), raw);
+      const Eigen::Vector3d at = raw[0] * mesh_.current.col(f[0]) +
+                                 raw[1] * mesh_.current.col(f[1]) +
+                                 raw[2] * mesh_.current.col(f[2]);
+      // Where the blade was, not the placed tip.
+      if ((at - tear_.tip_target_).norm() <= snap_ * size) return true;
+      path_.push_back({face, {PathPoint::Vertex, tear_.tip_}, hit});
+      return false;
+    }
+    return false;
+  }
+
+  // The walk that leaves the tip by move m; on reaching the blade it becomes the path.
+  void walk_from(const Move& m) {
+    std::vector<Crossing> trial{{m.face, {PathPoint::Vertex, tear_.tip_}, m.out}};
+    std::vector<std::int32_t> visited{m.face};
+    for (int guard = 0; guard < tear_.options_.max_walk_faces; ++guard) {
+      const WalkStep next = trial.back().out.kind == PathPoint::Edge ? cross_edge(trial, visited)
+                                                                     : pass_vertex(trial, visited);
+      if (next == WalkStep::Failed) return;
+      if (next == WalkStep::Reached) {
+        path_ = std::move(trial);
+        return;
+      }
+    }
+  }
+
+  enum class WalkStep { Moved, Reached, Failed };
+
+  // The walk is on an edge: into the face across it, which the blade crosses (reached) or
+  // which Π leaves through an edge at its third vertex z (not back through the edge).
+  WalkStep cross_edge(std::vector<Crossing>& trial, std::vector<std::int32_t>& visited) const {
+    const Crossing& last = trial.back();
+    const PathPoint at = last.out;
+    std::int32_t h = adjacency_.find(at.a, at.b);
+    if (h < 0 || h / 3 != last.face) h = adjacency_.find(at.b, at.a);
+    const std::int32_t o = h >= 0 ? adjacency_.twin(h) : -1;
+    if (o < 0) return WalkStep::Failed;  // a boundary: this direction fails
+    const std::int32_t g = o / 3;
+    if (std::find(visited.begin(), visited.end(), g) != visited.end()) return WalkStep::Failed;
+    visited.push_back(g);
+    PathPoint out;
+    if (blade_hit(g, out)) {
+      trial.push_back({g, at, out});
+      return WalkStep::Reached;
+    }
+    const int cz = (o % 3 + 2) % 3;
+    const std::int32_t z = mesh_.faces[static_cast<std::size_t>(g)][cz];
+    const double dz = delta(z);
+    const std::int32_t w = delta(at.a) * dz < 0 ? at.a : at.b;  // the end across Π from z
+    if (dz == 0) {
+      out = {PathPoint::Vertex, z};
+    } else {
+      const double dw = delta(w);
+      const double t = dz / (dz - dw);  // from z towards w
+      out = t < snap_ ? PathPoint{PathPoint::Vertex, z} : edge_point(z, w, t);
+    }
+    trial.push_back({g, at, out});
+    return WalkStep::Moved;
+  }
+
+  // The walk is at a vertex: the blade may be in a face around it, else it continues
+  // straight on through the best aligned face not yet visited.
+  WalkStep pass_vertex(std::vector<Crossing>& trial, std::vector<std::int32_t>& visited) const {
+    const Crossing& last = trial.back();
+    const PathPoint at = last.out;
+    const Eigen::Vector3d dir = Eigen::Vector3d(mesh_.current.col(at.v)) - pos(last.in, last.face);
+    const Face& lf = mesh_.faces[static_cast<std::size_t>(last.face)];
+    const std::int32_t nb = lf[(corner_of(last.face, at.v) + 1) % 3];
+    std::vector<std::int32_t> around;
+    const std::vector<Move> next = moves_from(at.v, nb, dir, around);
+    for (auto face : around) {
+      if (std::find(visited.begin(), visited.end(), face) != visited.end()) continue;
+      PathPoint hit;
+      if (blade_hit(face, hit)) {
+        trial.push_back({face, at, hit});
+        return WalkStep::Reached;
+      }
+    }
+    for (const Move& mv : next) {
+      if (mv.cosine <= 0) break;
+      if (std::find(visited.begin(), visited.end(), mv.face) != visited.end()) continue;
+      visited.push_back(mv.face);
+      trial.push_back({mv.face, at, mv.out});
+      return WalkStep::Moved;
+    }
+    return WalkStep::Failed;
+  }
+
+  // The id of path point p of face `face` in the change: a vertex, the edge point's new
+  // vertex (one per edge), or the new tip.
+  std::int32_t id_of(const PathPoint& p, std::int32_t face) {
+    if (p.kind == PathPoint::Vertex) return p.v;
+    if (p.kind == PathPoint::Edge) {
+      const std::int32_t lo = std::min(p.a, p.b), hi = std::max(p.a, p.b);
+      std::int32_t id = edge_ids_.find(lo, hi);
+      if (id < 0) {
+        id = nv0_ + static_cast<std::int32_t>(split_.new_vertices.size());
+        split_.new_vertices.push_back(NewVertex::on_edge(p.a, p.b, p.t));
+        edge_ids_.insert(lo, hi, id);
+      }
+      return id;
+    }
+    if (tip_id_ < 0) {
+      const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+      tip_id_ = nv0_ + static_cast<std::int32_t>(split_.new_vertices.size());
+      split_.new_vertices.push_back(
+          NewVertex::in_face(f[0], f[1], f[2], p.bary[0], p.bary[1], p.bary[2]));
+    }
+    return tip_id_;
+  }
+  Eigen::Vector3d position_of(std::int32_t id) const {
+    if (id < nv0_) return mesh_.current.col(id);
+    const NewVertex& nv = split_.new_vertices[static_cast<std::size_t>(id - nv0_)];
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k)
+      if (nv.parents[k] >= 0) x += nv.coefficients[k] * mesh_.current.col(nv.parents[k]);
+    return x;
+  }
+  static bool on_edge(const PathPoint& p, std::int32_t u, std::int32_t w) {
+    return p.kind == PathPoint::Edge && ((p.a == u && p.b == w) || (p.b == u && p.a == w));
+  }
+
+  // Step 3, first change: split the crossed faces along S_i, Q_1 … Q_m, S_i+1. False (and
+  // the mesh unchanged) when the new tip would be in a face too thin for it.
+  bool split_along_path() {
+    split_.base_vertex_count = nv0_ = mesh_.vertex_count();
+    split_.base_face_count = mesh_.face_count();
+    points_.push_back(tear_.tip_);
+    target_ = tear_.tip_target_;
+    for (Crossing& c : path_) {
+      if (c.out.kind == PathPoint::Inside && !place_new_tip(c)) return false;
+      split_face(c);
+    }
+    std::sort(split_.removed_faces.begin(), split_.removed_faces.end());
+    split_.removed_faces.erase(
+        std::unique(split_.removed_faces.begin(), split_.removed_faces.end()),
+        split_.removed_faces.end());
+    tear_.commit(std::move(split_), step_);
+    return true;
+  }
+
+  // The new tip in crossing c's face, moved so that its fan makes no sliver.
+  bool place_new_tip(Crossing& c) {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
+    const Eigen::Vector3d fa = mesh_.current.col(f[0]), fb = mesh_.current.col(f[1]),
+                          fc = mesh_.current.col(f[2]);
+    std::vector<Eigen::Vector3d> ring;
+    for (int k = 0; k < 3; ++k) {
+      ring.push_back(mesh_.current.col(f[k]));
+      if (c.in.kind == PathPoint::Edge && on_edge(c.in, f[k], f[(k + 1) % 3]))
+        ring.push_back(pos(c.in, c.face));
+    }
+    target_ = pos(c.out, c.face);
+    // Aim at the floor itself. A face the tear made (it holds a vertex the tear added), e.g.
+    // in the old tip's fan after a short step, whose fan cannot keep the floor is not split:
+    // the step waits for the blade to move on (splitting it anyway would halve its thin
+    // corners step after step). An input face needs only its own bound.
+    const double min_angle = tear_.options_.min_angle;
+    const double floor2 = std::pow(std::sin(min_angle), 2);
+    double achieved = 0;
+    c.out.bary = place_tip(c.out.bary, fa, fb, fc, ring, min_angle, &achieved, floor2);
+    const std::int32_t first_new = tear_.first_new_vertex_;
+    const bool made_by_tear = f[0] >= first_new || f[1] >= first_new || f[2] >= first_new;
+    if (achieved < floor2 && made_by_tear) {
+      tear_.message_ = "the blade is in a face too thin for a new tip: waiting for it to move on";
+      return false;
+    }
+    return true;
+  }
+
+  // Crossing c's face as a polygon with the path's edge points inserted, split along the
+  // path: a fan around the new tip, or the two sides of the chord (quads along the diagonal
+  // with the larger smallest angle); a face crossed along an existing edge stays.
+  void split_face(const Crossing& c) {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
+    const std::int32_t in = id_of(c.in, c.face), out = id_of(c.out, c.face);
+    points_.push_back(out);
+    std::vector<std::int32_t> poly;
+    for (int k = 0; k < 3; ++k) {
+      poly.push_back(f[k]);
+      for (const PathPoint* p : {&c.in, &c.out})
+        if (on_edge(*p, f[k], f[(k + 1) % 3])) poly.push_back(id_of(*p, c.face));
+    }
+    TopologyChange& a = split_;
+    a.removed_faces.push_back(c.face);
+    const auto m = poly.size();
+    if (c.out.kind == PathPoint::Inside) {
+      for (std::size_t i = 0; i < m; ++i)
+        a.added_faces.push_back({poly[i], poly[(i + 1) % m], out});
+      return;
+    }
+    const auto i_in =
+        static_cast<std::size_t>(std::find(poly.begin(), poly.end(), in) - poly.begin());
+    const auto i_out =
+        static_cast<std::size_t>(std::find(poly.begin(), poly.end(), out) - poly.begin());
+    if ((i_in + 1) % m == i_out || (i_out + 1) % m == i_in) {
+      a.removed_faces.pop_back();  // along an existing edge: the face stays
+      return;
+    }
+    for (auto [from, to] : {std::pair{i_in, i_out}, std::pair{i_out, i_in}}) {
+      std::vector<std::int32_t> sub;
+      for (std::size_t i = from;; i = (i + 1) % m) {
+        sub.push_back(poly[i]);
+        if (i == to) break;
+      }
+      if (sub.size() == 3) {
+        a.added_faces.push_back({sub[0], sub[1], sub[2]});
+        continue;
+      }
+      const QuadSplit quad = best_quad_split(
+          position_of(sub[0]), position_of(sub[1]), position_of(sub[2]), position_of(sub[3]),
+          [](const auto& x, const auto& y, const auto& z) { return smallest_angle_sin2(x, y, z); });
+      if (quad.first_diagonal) {
+        a.added_faces.push_back({sub[0], sub[1], sub[2]});
+        a.added_faces.push_back({sub[0], sub[2], sub[3]});
+      } else {
+        a.added_faces.push_back({sub[0], sub[1], sub[3]});
+        a.added_faces.push_back({sub[1], sub[2], sub[3]});
+      }
+    }
+  }
+
+  // Step 3, second change: duplicate the interior points for the faces on the path's left,
+  // found by turning counter-clockwise around each from the outgoing path edge to the
+  // incoming one (or to the open slit, at the old tip).
+  void open_left_side() {
+    TopologyChange b;
+    b.base_vertex_count = mesh_.vertex_count();
+    b.base_face_count = mesh_.face_count();
+    std::map<std::int32_t, Face> remapped;
+    const auto& path = tear_.path_;
+    const std::int32_t prev_tip = path.size() >= 2 ? path[path.size() - 2].right : -1;
+    dups_.assign(points_.size(), -1);
+    left_dir_.assign(points_.size(), n_);
+    std::vector<std::int32_t> faces;
+    for (std::size_t j = 0; j + 1 < points_.size(); ++j) {
+      if (j == 0 && path.size() == 1) continue;  // the start of the tear stays one point
+      const std::int32_t p = points_[j];
+      const std::int32_t prev = j == 0 ? prev_tip : points_[j - 1];
+      if (!left_faces(p, points_[j + 1], prev, faces))
+        continue;  // no incoming edge around: leave this point joined
+      const std::int32_t dup =
+          b.base_vertex_count + static_cast<std::int32_t>(b.new_vertices.size());
+      b.new_vertices.push_back(NewVertex::duplicate(p));
+      dups_[j] = dup;
+      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+      for (auto fi : faces) {
+        auto it = remapped.try_emplace(fi, mesh_.faces[static_cast<std::size_t>(fi)]).first;
+        for (auto& v : it->second)
+          if (v == p) v = dup;
+        const Face& f = mesh_.faces[static_cast<std::size_t>(fi)];
+        centroid +=
+            (mesh_.current.col(f[0]) + mesh_.current.col(f[1]) + mesh_.current.col(f[2])) / 3;
+      }
+      centroid /= static_cast<double>(faces.size());
+      left_dir_[j] = (centroid - mesh_.current.col(p)).dot(n_) >= 0 ? n_ : Eigen::Vector3d(-n_);
+    }
+    for (const auto& [fi, f] : remapped) {
+      b.removed_faces.push_back(fi);
+      b.added_faces.push_back(f);
+    }
+    if (!b.empty()) tear_.commit(std::move(b), step_);
+  }
+
+  // The faces counter-clockwise around path point p from the outgoing edge (p, next) to the
+  // incoming one from `prev` (or a boundary); false when there is no incoming edge around.
+  bool left_faces(std::int32_t p, std::int32_t next, std::int32_t prev,
+                  std::vector<std::int32_t>& faces) const {
+    faces.clear();
+    const std::int32_t h0 = adjacency_.find(p, next);
+    if (h0 < 0) return false;
+    std::int32_t h = h0;
+    for (int guard = 0;; ++guard) {
+      faces.push_back(h / 3);
+      const std::int32_t pv = 3 * (h / 3) + (h % 3 + 2) % 3;
+      const std::int32_t o = adjacency_.twin(pv);
+      if (o < 0) return true;
+      const Face& of = mesh_.faces[static_cast<std::size_t>(o / 3)];
+      if (of[(o % 3 + 1) % 3] == prev) return true;  // reached the incoming path edge
+      if (o == h0 || guard > 4096) return false;
+      h = o;
+    }
+  }
+
+  // The path recorded: the old tip becomes interior, then the Q_j, then the new tip.
+  void record() {
+    auto& path = tear_.path_;
+    path.back().left = dups_[0];
+    path.back().normal = left_dir_[0];
+    for (std::size_t j = 1; j < points_.size(); ++j)
+      path.push_back({points_[j], j + 1 < points_.size() ? dups_[j] : -1, left_dir_[j]});
+    tear_.tip_neighbor_ = points_[points_.size() - 2];
+    tear_.tip_ = points_.back();
+    tear_.tip_target_ = target_;
+    ++tear_.steps_;
+    step_.extended = true;
+    tear_.message_.clear();
+  }
+
+  Tear& tear_;
+  SkinnedMesh& mesh_;
+  Adjacency& adjacency_;
+  const ScalpelSample& s_;
+  TearStep& step_;
+  const double snap_;
+  // Step 1
+  Eigen::Vector3d tip_, n_, toward_;
+  cga::Plane<double> plane_;
+  double zero_ = 0;  // |distance to Π| taken as on it
+  // Step 2
+  std::vector<Crossing> path_;
+  // Step 3
+  TopologyChange split_;
+  std::int32_t nv0_ = 0;
+  EdgeMap edge_ids_;  // edge → its new vertex
+  std::int32_t tip_id_ = -1;
+  std::vector<std::int32_t> points_;  // S_i, Q_1 … Q_m, S_i+1
+  Eigen::Vector3d target_;            // the blade's hit the new tip stands for
+  std::vector<std::int32_t> dups_;    // per point, its copy for the left, or −1
+  std::vector<Eigen::Vector3d> left_dir_;
+};
+
 Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, const TearOptions& options)
     : mesh_(mesh),
       adjacency_(adjacency),
@@ -159,10 +642,7 @@ void Tear::commit(TopologyChange&& change, TearStep& step) {
 
 bool Tear::start(const ScalpelSample& s, TearStep& step) {
   SegmentHit first;
-  if (options_.search == FaceSearch::Scan) {
-    const auto hits = scan_segment_hits(mesh_, s.a, s.b);
-    if (!hits.empty()) first = hits.front();
-  } else if (index_) {
+  if (index_) {
     if (!index_->matches(mesh_))
       throw std::invalid_argument("tear: the face index does not describe this mesh");
     index_->ensure_fitted(mesh_);
@@ -221,400 +701,7 @@ TearStep Tear::advance(const ScalpelSample& s) {
     }
   } batch{index_, mesh_};
   if (index_) index_->begin_batch();
-  const Eigen::Vector3d tip = mesh_.current.col(tip_);
-  const auto plane = cga::Plane<double>::through(tip, s.a, s.b);
-  if (!plane) {
-    message_ = "the blade is collinear with the tip: no plane";
-    return step;
-  }
-  const Eigen::Vector3d n = plane->normal();
-  const double scale = std::max({(s.a - tip).norm(), (s.b - tip).norm(), 1e-300});
-  const double zero = 1e-12 * scale;
-  auto delta = [&](std::int32_t v) {
-    const double d = plane->signed_distance(mesh_.current.col(v));
-    return std::abs(d) <= zero ? 0.0 : d;
-  };
-  const double snap = options_.snap_fraction;
-  auto pos = [&](const PathPoint& p, std::int32_t face) -> Eigen::Vector3d {
-    if (p.kind == PathPoint::Vertex) return mesh_.current.col(p.v);
-    if (p.kind == PathPoint::Edge)
-      return (1 - p.t) * mesh_.current.col(p.a) + p.t * mesh_.current.col(p.b);
-    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
-    return p.bary[0] * mesh_.current.col(f[0]) + p.bary[1] * mesh_.current.col(f[1]) +
-           p.bary[2] * mesh_.current.col(f[2]);
-  };
-  auto blade_hit = [&](std::int32_t face, PathPoint& out) {
-    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
-    std::array<double, 3> bary{};
-    if (!segment_triangle(s.a, s.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
-                          mesh_.current.col(f[2]), bary))
-      return false;
-    for (auto& x : bary) x = std::max(x, snap);
-    const double sum = bary[0] + bary[1] + bary[2];
-    for (auto& x : bary) x /= sum;
-    out.kind = PathPoint::Inside;
-    out.bary = bary;
-    return true;
-  };
-  // Where Π leaves face `face` through the edge opposite its corner `corner` (x = next,
-  // y = after): a vertex, or a point on the edge; false when Π does not cross that edge.
-  auto exit_opposite = [&](std::int32_t face, int corner, bool snap_x, bool snap_y,
-                           PathPoint& out) {
-    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
-    const std::int32_t x = f[(corner + 1) % 3], y = f[(corner + 2) % 3];
-    const double dx = delta(x), dy = delta(y);
-    if (dx == 0 && snap_x) return out = {PathPoint::Vertex, x}, true;
-    if (dy == 0 && snap_y) return out = {PathPoint::Vertex, y}, true;
-    if (!(dx * dy < 0)) return false;
-    double t = dx / (dx - dy);
-    if (t < snap) {
-      if (snap_x) return out = {PathPoint::Vertex, x}, true;
-    } else if (t > 1 - snap) {
-      if (snap_y) return out = {PathPoint::Vertex, y}, true;
-    }
-    const auto [lo, hi] = safe_range(mesh_, adjacency_, x, y, options_.min_angle);
-    t = std::clamp(t, std::max(lo, snap), std::max(std::min(hi, 1 - snap), std::max(lo, snap)));
-    out = {PathPoint::Edge, -1, x, y, t};
-    return true;
-  };
-  // The blade's point nearest the tip gives the direction to walk in.
-  const Eigen::Vector3d ab = s.b - s.a;
-  const double u = std::clamp((tip - s.a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
-  const Eigen::Vector3d toward = s.a + u * ab - tip;
-
-  // Candidate first moves from a vertex: (face, corner of the vertex, exit, cosine).
-  struct Move {
-    std::int32_t face;
-    PathPoint out;
-    double cosine;
-  };
-  auto moves_from = [&](std::int32_t v, std::int32_t any_neighbor, const Eigen::Vector3d& dir,
-                        std::vector<std::int32_t>& fan_faces) {
-    std::vector<Move> moves;
-    std::int32_t h = adjacency_.find(v, any_neighbor);
-    if (h < 0) {
-      const std::int32_t g = adjacency_.find(any_neighbor, v);
-      if (g < 0) return moves;
-      h = 3 * (g / 3) + (g % 3 + 1) % 3;
-    }
-    fan_faces.clear();
-    for (auto he : fan(adjacency_, h)) {
-      const std::int32_t face = he / 3;
-      fan_faces.push_back(face);
-      PathPoint out;
-      if (!exit_opposite(face, he % 3, true, true, out)) continue;
-      const Eigen::Vector3d e = pos(out, face) - mesh_.current.col(v);
-      const double len = e.norm() * dir.norm();
-      moves.push_back({face, out, len > 0 ? e.dot(dir) / len : -1});
-    }
-    std::sort(moves.begin(), moves.end(),
-              [](const Move& a, const Move& b) { return a.cosine > b.cosine; });
-    return moves;
-  };
-  auto corner_of = [&](std::int32_t face, std::int32_t v) {
-    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
-    return f[0] == v ? 0 : (f[1] == v ? 1 : 2);
-  };
-
-  // Walk from the tip; the first candidate direction that reaches the blade wins.
-  std::vector<Crossing> path;
-  std::int32_t neighbor = -1;
-  {
-    // Any neighbour of the tip: the vertices of a face holding it, found through the last
-    // path point or the start face.
-    neighbor = path_.size() >= 2 ? path_[path_.size() - 2].right : -1;
-    if (neighbor < 0 ||
-        (adjacency_.find(tip_, neighbor) < 0 && adjacency_.find(neighbor, tip_) < 0))
-      neighbor = tip_neighbor_;
-  }
-  std::vector<std::int32_t> fan_faces;
-  std::vector<Move> first = moves_from(tip_, neighbor, toward, fan_faces);
-  bool unmoved = false;
-  for (auto face : fan_faces) {
-    PathPoint hit;
-    if (!blade_hit(face, hit)) continue;
-    // The blade still meets the surface next to the tip: nothing to tear yet.
-    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
-    const double size = (mesh_.current.col(f[1]) - mesh_.current.col(f[0])).norm();
-    std::array<double, 3> raw{};
-    segment_triangle(s.a, s.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
-                     mesh_.current.col(f[2]), raw);
-    const Eigen::Vector3d at = raw[0] * mesh_.current.col(f[0]) + raw[1] * mesh_.current.col(f[1]) +
-                               raw[2] * mesh_.current.col(f[2]);
-    if ((at - tip_target_).norm() <= snap * size) {  // where the blade was, not the placed tip
-      unmoved = true;
-    } else {
-      path.push_back({face, {PathPoint::Vertex, tip_}, hit});
-    }
-    break;
-  }
-  if (unmoved) {
-    message_ = "the blade has not moved away from the tip";
-    return step;
-  }
-  for (const Move& m : first) {
-    if (!path.empty()) break;
-    if (m.cosine <= 0) break;
-    std::vector<Crossing> trial{{m.face, {PathPoint::Vertex, tip_}, m.out}};
-    std::vector<std::int32_t> visited{m.face};
-    bool done = false;
-    for (int guard = 0; guard < options_.max_walk_faces && !done; ++guard) {
-      const Crossing& last = trial.back();
-      const PathPoint at = last.out;
-      if (at.kind == PathPoint::Edge) {
-        std::int32_t h = adjacency_.find(at.a, at.b);
-        if (h < 0 || h / 3 != last.face) h = adjacency_.find(at.b, at.a);
-        const std::int32_t o = h >= 0 ? adjacency_.twin(h) : -1;
-        if (o < 0) break;  // a boundary: this direction fails
-        const std::int32_t g = o / 3;
-        if (std::find(visited.begin(), visited.end(), g) != visited.end()) break;
-        visited.push_back(g);
-        PathPoint out;
-        if (blade_hit(g, out)) {
-          trial.push_back({g, at, out});
-          done = true;
-          break;
-        }
-        // Leave g through one of the edges at its third vertex z (not back through (a, b)).
-        const int cz = (o % 3 + 2) % 3;
-        const Face& fg = mesh_.faces[static_cast<std::size_t>(g)];
-        const std::int32_t z = fg[cz];
-        const double dz = delta(z);
-        const std::int32_t w = delta(at.a) * dz < 0 ? at.a : at.b;  // the end across Π from z
-        if (dz == 0) {
-          out = {PathPoint::Vertex, z};
-        } else {
-          const double dw = delta(w);
-          double t = dz / (dz - dw);  // from z towards w
-          if (t < snap) {
-            out = {PathPoint::Vertex, z};
-          } else {
-            // Off Π if need be, into the range where it makes no sliver on either side.
-            const auto [lo, hi] = safe_range(mesh_, adjacency_, z, w, options_.min_angle);
-            t = std::clamp(t, std::max(lo, snap),
-                           std::max(std::min(hi, 1 - snap), std::max(lo, snap)));
-            out = {PathPoint::Edge, -1, z, w, t};
-          }
-        }
-        trial.push_back({g, at, out});
-      } else {
-        // Through a vertex: the blade may be in a face around it, else continue straight on.
-        const Eigen::Vector3d wpos = mesh_.current.col(at.v);
-        const Eigen::Vector3d dir = wpos - pos(last.in, last.face);
-        const Face& lf = mesh_.faces[static_cast<std::size_t>(last.face)];
-        const std::int32_t nb = lf[(corner_of(last.face, at.v) + 1) % 3];
-        std::vector<std::int32_t> around;
-        std::vector<Move> next = moves_from(at.v, nb, dir, around);
-        for (auto face : around) {
-          if (std::find(visited.begin(), visited.end(), face) != visited.end()) continue;
-          PathPoint hit;
-          if (blade_hit(face, hit)) {
-            trial.push_back({face, at, hit});
-            done = true;
-            break;
-          }
-        }
-        if (done) break;
-        bool moved = false;
-        for (const Move& mv : next) {
-          if (mv.cosine <= 0) break;
-          if (std::find(visited.begin(), visited.end(), mv.face) != visited.end()) continue;
-          visited.push_back(mv.face);
-          trial.push_back({mv.face, at, mv.out});
-          moved = true;
-          break;
-        }
-        if (!moved) break;
-      }
-    }
-    if (done) path = std::move(trial);
-  }
-  if (path.empty()) {
-    message_ =
-        "the walk from the tip did not reach the blade (outside the mesh, unmoved, or past a "
-        "boundary)";
-    return step;
-  }
-
-  // Phase A: split the crossed faces along the path.
-  TopologyChange a;
-  a.base_vertex_count = mesh_.vertex_count();
-  a.base_face_count = mesh_.face_count();
-  const std::int32_t nv0 = mesh_.vertex_count();
-  EdgeMap edge_ids;
-  std::int32_t tip_id = -1;
-  auto id_of = [&](const PathPoint& p, std::int32_t face) {
-    if (p.kind == PathPoint::Vertex) return p.v;
-    if (p.kind == PathPoint::Edge) {
-      const std::int32_t lo = std::min(p.a, p.b), hi = std::max(p.a, p.b);
-      std::int32_t id = edge_ids.find(lo, hi);
-      if (id < 0) {
-        id = nv0 + static_cast<std::int32_t>(a.new_vertices.size());
-        a.new_vertices.push_back(NewVertex::on_edge(p.a, p.b, p.t));
-        edge_ids.insert(lo, hi, id);
-      }
-      return id;
-    }
-    if (tip_id < 0) {
-      const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
-      tip_id = nv0 + static_cast<std::int32_t>(a.new_vertices.size());
-      a.new_vertices.push_back(
-          NewVertex::in_face(f[0], f[1], f[2], p.bary[0], p.bary[1], p.bary[2]));
-    }
-    return tip_id;
-  };
-  auto position_of = [&](std::int32_t id) -> Eigen::Vector3d {
-    if (id < nv0) return mesh_.current.col(id);
-    const NewVertex& nv = a.new_vertices[static_cast<std::size_t>(id - nv0)];
-    Eigen::Vector3d x = Eigen::Vector3d::Zero();
-    for (int k = 0; k < 3; ++k)
-      if (nv.parents[k] >= 0) x += nv.coefficients[k] * mesh_.current.col(nv.parents[k]);
-    return x;
-  };
-  std::vector<std::int32_t> points{tip_};
-  Eigen::Vector3d target = tip_target_;
-  for (Crossing& c : path) {
-    const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
-    if (c.out.kind == PathPoint::Inside) {  // the new tip: no sliver in its fan
-      const Eigen::Vector3d fa = mesh_.current.col(f[0]), fb = mesh_.current.col(f[1]),
-                            fc = mesh_.current.col(f[2]);
-      std::vector<Eigen::Vector3d> ring;
-      for (int k = 0; k < 3; ++k) {
-        ring.push_back(mesh_.current.col(f[k]));
-        if (c.in.kind == PathPoint::Edge && ((c.in.a == f[k] && c.in.b == f[(k + 1) % 3]) ||
-                                             (c.in.b == f[k] && c.in.a == f[(k + 1) % 3])))
-          ring.push_back(pos(c.in, c.face));
-      }
-      target = pos(c.out, c.face);
-      // Aim at the floor itself. A face the tear made (it holds a vertex the tear added), e.g.
-      // in the old tip's fan after a short step, whose fan cannot keep the floor is not split:
-      // the step waits for the blade to move on (splitting it anyway would halve its thin
-      // corners step after step). An input face needs only its own bound.
-      const double floor2 = std::pow(std::sin(options_.min_angle), 2);
-      double achieved = 0;
-      c.out.bary = place_tip(c.out.bary, fa, fb, fc, ring, options_.min_angle, &achieved, floor2);
-      const bool made_by_tear =
-          f[0] >= first_new_vertex_ || f[1] >= first_new_vertex_ || f[2] >= first_new_vertex_;
-      if (achieved < floor2 && made_by_tear) {
-        message_ = "the blade is in a face too thin for a new tip: waiting for it to move on";
-        return step;
-      }
-    }
-    const std::int32_t in = id_of(c.in, c.face), out = id_of(c.out, c.face);
-    points.push_back(out);
-    // The face as a polygon with the path's edge points inserted.
-    std::vector<std::int32_t> poly;
-    for (int k = 0; k < 3; ++k) {
-      poly.push_back(f[k]);
-      for (const PathPoint* p : {&c.in, &c.out})
-        if (p->kind == PathPoint::Edge &&
-            ((p->a == f[k] && p->b == f[(k + 1) % 3]) || (p->b == f[k] && p->a == f[(k + 1) % 3])))
-          poly.push_back(id_of(*p, c.face));
-    }
-    a.removed_faces.push_back(c.face);
-    const auto m = poly.size();
-    if (c.out.kind == PathPoint::Inside) {
-      for (std::size_t i = 0; i < m; ++i)
-        a.added_faces.push_back({poly[i], poly[(i + 1) % m], out});
-      continue;
-    }
-    const auto i_in =
-        static_cast<std::size_t>(std::find(poly.begin(), poly.end(), in) - poly.begin());
-    const auto i_out =
-        static_cast<std::size_t>(std::find(poly.begin(), poly.end(), out) - poly.begin());
-    if ((i_in + 1) % m == i_out || (i_out + 1) % m == i_in) {
-      a.removed_faces.pop_back();  // along an existing edge: the face stays
-      continue;
-    }
-    for (auto [from, to] : {std::pair{i_in, i_out}, std::pair{i_out, i_in}}) {
-      std::vector<std::int32_t> sub;
-      for (std::size_t i = from;; i = (i + 1) % m) {
-        sub.push_back(poly[i]);
-        if (i == to) break;
-      }
-      if (sub.size() == 3) {
-        a.added_faces.push_back({sub[0], sub[1], sub[2]});
-      } else {  // a quad: along the diagonal with the larger smallest angle
-        if (first_diagonal(position_of(sub[0]), position_of(sub[1]), position_of(sub[2]),
-                           position_of(sub[3]))) {
-          a.added_faces.push_back({sub[0], sub[1], sub[2]});
-          a.added_faces.push_back({sub[0], sub[2], sub[3]});
-        } else {
-          a.added_faces.push_back({sub[0], sub[1], sub[3]});
-          a.added_faces.push_back({sub[1], sub[2], sub[3]});
-        }
-      }
-    }
-  }
-  std::sort(a.removed_faces.begin(), a.removed_faces.end());
-  a.removed_faces.erase(std::unique(a.removed_faces.begin(), a.removed_faces.end()),
-                        a.removed_faces.end());
-  commit(std::move(a), step);
-
-  // Phase B: duplicate the interior points for the faces on the path's left, found by turning
-  // counter-clockwise around each from the outgoing path edge to the incoming one (or to the
-  // open slit, at the old tip).
-  TopologyChange b;
-  b.base_vertex_count = mesh_.vertex_count();
-  b.base_face_count = mesh_.face_count();
-  std::map<std::int32_t, Face> remapped;
-  const std::int32_t prev_tip = path_.size() >= 2 ? path_[path_.size() - 2].right : -1;
-  std::vector<std::int32_t> dups(points.size(), -1);
-  std::vector<Eigen::Vector3d> left_dir(points.size(), n);
-  for (std::size_t j = 0; j + 1 < points.size(); ++j) {
-    if (j == 0 && path_.size() == 1) continue;  // the start of the tear stays one point
-    const std::int32_t p = points[j], next = points[j + 1];
-    const std::int32_t prev = j == 0 ? prev_tip : points[j - 1];
-    const std::int32_t h0 = adjacency_.find(p, next);
-    if (h0 < 0) continue;
-    std::vector<std::int32_t> faces;
-    std::int32_t h = h0;
-    bool ok = true;
-    for (int guard = 0;; ++guard) {
-      faces.push_back(h / 3);
-      const std::int32_t pv = 3 * (h / 3) + (h % 3 + 2) % 3;
-      const std::int32_t o = adjacency_.twin(pv);
-      if (o < 0) break;
-      const Face& of = mesh_.faces[static_cast<std::size_t>(o / 3)];
-      if (of[(o % 3 + 1) % 3] == prev) break;  // reached the incoming path edge
-      if (o == h0 || guard > 4096) {
-        ok = false;
-        break;
-      }
-      h = o;
-    }
-    if (!ok) continue;  // no incoming edge around: leave this point joined
-    const std::int32_t dup = b.base_vertex_count + static_cast<std::int32_t>(b.new_vertices.size());
-    b.new_vertices.push_back(NewVertex::duplicate(p));
-    dups[j] = dup;
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (auto fi : faces) {
-      auto it = remapped.try_emplace(fi, mesh_.faces[static_cast<std::size_t>(fi)]).first;
-      for (auto& v : it->second)
-        if (v == p) v = dup;
-      const Face& f = mesh_.faces[static_cast<std::size_t>(fi)];
-      centroid += (mesh_.current.col(f[0]) + mesh_.current.col(f[1]) + mesh_.current.col(f[2])) / 3;
-    }
-    centroid /= static_cast<double>(faces.size());
-    left_dir[j] = (centroid - mesh_.current.col(p)).dot(n) >= 0 ? n : Eigen::Vector3d(-n);
-  }
-  for (const auto& [fi, f] : remapped) {
-    b.removed_faces.push_back(fi);
-    b.added_faces.push_back(f);
-  }
-  if (!b.empty()) commit(std::move(b), step);
-
-  // Record the path: the old tip becomes interior, then the Q_j, then the new tip.
-  path_.back().left = dups[0];
-  path_.back().normal = left_dir[0];
-  for (std::size_t j = 1; j < points.size(); ++j)
-    path_.push_back({points[j], j + 1 < points.size() ? dups[j] : -1, left_dir[j]});
-  tip_neighbor_ = points[points.size() - 2];
-  tip_ = points.back();
-  tip_target_ = target;
-  ++steps_;
-  step.extended = true;
-  message_.clear();
+  TearAdvance(*this, s, step).run();
   return step;
 }
 

@@ -1,5 +1,7 @@
 #include "conform/mesh/topology_change.hpp"
 
+#include "conform/mesh/detail/apply_steps.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -46,20 +48,20 @@ std::string TopologyChange::validate() const {
 }
 
 std::int32_t TopologyChange::face_after(std::int32_t f) const {
-  const auto it = std::lower_bound(removed_faces.begin(), removed_faces.end(), f);
-  const bool removed = it != removed_faces.end() && *it == f;
-  const std::size_t filled = std::min(removed_faces.size(), added_faces.size());
-  if (removed) return -1;  // even a refilled slot now holds an added face, not f
-  // Simulate step 3 for the base face f: it moves only if it is the last face when a slot is
-  // filled. Few slots remain, so this walks them directly.
-  std::int32_t count = base_face_count + static_cast<std::int32_t>(added_faces.size() - filled);
-  std::int32_t where = f;
-  for (std::size_t k = removed_faces.size(); k-- > filled;) {
-    const std::int32_t slot = removed_faces[k];
-    if (where == count - 1 && slot != count - 1) where = slot;
-    --count;
-  }
-  return where;
+  if (std::binary_search(removed_faces.begin(), removed_faces.end(), f))
+    return -1;  // even a refilled slot now holds an added face, not f
+  // A base face moves only in step 3, when it is the last face as a slot is filled.
+  struct Follow {
+    std::int32_t where;
+    void fill(std::int32_t, std::size_t) {}
+    void append(std::int32_t, std::size_t) {}
+    void move(std::int32_t last, std::int32_t slot) {
+      if (where == last) where = slot;
+    }
+    void pop(std::int32_t) {}
+  } follow{f};
+  visit_face_slots(*this, follow);
+  return follow.where;
 }
 
 void blend_influences(SkinnedMesh& mesh, const std::array<std::int32_t, 3>& parents,
@@ -106,9 +108,11 @@ void apply(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency
     throw std::invalid_argument("apply: the adjacency does not describe this mesh");
   if (const std::string problem = change.validate(); !problem.empty())
     throw std::invalid_argument("apply: " + problem);
-  apply_vertices(mesh, change);
-  apply_faces(mesh, change, adjacency);
+  detail::apply_vertices(mesh, change);
+  detail::apply_faces(mesh, change, adjacency);
 }
+
+namespace detail {
 
 void apply_vertices(SkinnedMesh& mesh, const TopologyChange& change) {
   // Vertices: grow every per-vertex array, then fill the new columns in order (a new vertex may
@@ -154,38 +158,42 @@ void apply_vertices(SkinnedMesh& mesh, const TopologyChange& change) {
 }
 
 void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency) {
-  // Faces, in the documented slot order.
-  const auto& removed = change.removed_faces;
   const auto& added = change.added_faces;
   if (adjacency)
-    for (auto f : removed) adjacency->remove_face(mesh, f);
-  const std::size_t filled = std::min(removed.size(), added.size());
-  for (std::size_t k = 0; k < filled; ++k) {
-    mesh.faces[static_cast<std::size_t>(removed[k])] = added[k];
-    if (adjacency) adjacency->add_face(mesh, removed[k]);
-  }
-  if (added.size() > filled) {
-    // Size the adjacency's half-edge array once for all appended faces rather than face by
-    // face. (The face array keeps std::vector's doubling: reserving its exact size instead
-    // measured 2x slower cuts on the arm, glibc then returning and re-faulting the heap's top
-    // pages on every cut.)
-    const std::size_t grown = mesh.faces.size() + (added.size() - filled);
-    if (adjacency) adjacency->resize_faces(static_cast<std::int32_t>(grown));
-  }
-  for (std::size_t k = filled; k < added.size(); ++k) {
-    mesh.faces.push_back(added[k]);
-    if (adjacency) adjacency->add_face(mesh, mesh.face_count() - 1);
-  }
-  for (std::size_t k = removed.size(); k-- > filled;) {
-    const std::int32_t slot = removed[k];
-    const std::int32_t last = mesh.face_count() - 1;
-    if (slot != last) {
+    for (auto f : change.removed_faces) adjacency->remove_face(mesh, f);
+  const std::size_t filled = std::min(change.removed_faces.size(), added.size());
+  struct Slots {
+    SkinnedMesh& mesh;
+    Adjacency* adjacency;
+    const std::vector<Face>& added;
+    std::size_t filled;
+    void fill(std::int32_t slot, std::size_t k) {
+      mesh.faces[static_cast<std::size_t>(slot)] = added[k];
+      if (adjacency) adjacency->add_face(mesh, slot);
+    }
+    void append(std::int32_t slot, std::size_t k) {
+      // Size the adjacency's half-edge array once for all appended faces rather than face by
+      // face. (The face array keeps std::vector's doubling: reserving its exact size instead
+      // measured 2x slower cuts on the arm, glibc then returning and re-faulting the heap's top
+      // pages on every cut.)
+      if (k == filled && adjacency)
+        adjacency->resize_faces(
+            static_cast<std::int32_t>(mesh.faces.size() + (added.size() - filled)));
+      mesh.faces.push_back(added[k]);
+      if (adjacency) adjacency->add_face(mesh, slot);
+    }
+    void move(std::int32_t last, std::int32_t slot) {
       mesh.faces[static_cast<std::size_t>(slot)] = mesh.faces.back();
       if (adjacency) adjacency->move_face(mesh, last, slot);
     }
-    mesh.faces.pop_back();
-    if (adjacency) adjacency->resize_faces(mesh.face_count());
-  }
+    void pop(std::int32_t) {
+      mesh.faces.pop_back();
+      if (adjacency) adjacency->resize_faces(mesh.face_count());
+    }
+  };
+  visit_face_slots(change, Slots{mesh, adjacency, added, filled});
 }
+
+}  // namespace detail
 
 }  // namespace conform::mesh

@@ -71,26 +71,12 @@ Arm make_arm(int resolution) {
   return make_arm(o);
 }
 
-Arm make_arm(const ArmOptions& o) {
-  if (!(o.upper_arm > 0) || !(o.forearm > 0) || !(o.hand > 0) || !(o.elbow_blend > 0) ||
-      !(o.wrist_blend > 0))
-    throw std::invalid_argument("make_arm: lengths and blend widths must be positive");
-  if (o.segments <= 0 && o.resolution < 1)
-    throw std::invalid_argument("make_arm: resolution must be at least 1");
-  const int segments = o.segments > 0 ? o.segments : 32 * o.resolution;
-  const int rings = o.rings > 0 ? o.rings : 80 * o.resolution;
-  if (segments < 3 || rings < 2)
-    throw std::invalid_argument("make_arm: need at least 3 segments and 2 rings");
-  const long long vcount = static_cast<long long>(rings) * segments + 2;
-  if (vcount > (1ll << 30)) throw std::invalid_argument("make_arm: resolution too large");
+namespace {
 
-  const double scale = (o.upper_arm + o.forearm) / 0.55;  // 1 for the default arm
-  Profile p{o.upper_arm, o.upper_arm + o.forearm, o.upper_arm + o.forearm + o.hand, 0.048 * scale,
-            std::min(0.025 * scale, 0.45 * o.hand)};
-
-  // Place the rings at equal arc length along the meridian (z, mean radius) between the two
-  // poles, so that the caps get as many rings per centimetre as the tube: a fine polyline of
-  // the meridian, then inverse interpolation of its cumulative length.
+// The ring heights at equal arc length along the meridian (z, mean radius) between the two
+// poles, so that the caps get as many rings per centimetre as the tube: a fine polyline of
+// the meridian, then inverse interpolation of its cumulative length.
+std::vector<double> ring_heights(const Profile& p, int rings) {
   const int fine = std::max(20000, 8 * rings);
   std::vector<double> zs(static_cast<std::size_t>(fine) + 1), len(zs.size());
   auto mean_r = [&](double z) {
@@ -106,19 +92,20 @@ Arm make_arm(const ArmOptions& o) {
                     : len[i - 1] + std::hypot(zs[i] - zs[i - 1], mean_r(zs[i]) - mean_r(zs[i - 1]));
   }
   std::vector<double> ring_z(static_cast<std::size_t>(rings));
-  {
-    std::size_t k = 0;
-    for (int i = 0; i < rings; ++i) {
-      const double s = len.back() * (i + 1) / (rings + 1);
-      while (k + 1 < len.size() && len[k + 1] < s) ++k;
-      const double u = (s - len[k]) / std::max(1e-300, len[k + 1] - len[k]);
-      ring_z[i] = lerp(zs[k], zs[k + 1], u);
-    }
+  std::size_t k = 0;
+  for (int i = 0; i < rings; ++i) {
+    const double s = len.back() * (i + 1) / (rings + 1);
+    while (k + 1 < len.size() && len[k + 1] < s) ++k;
+    const double u = (s - len[k]) / std::max(1e-300, len[k + 1] - len[k]);
+    ring_z[i] = lerp(zs[k], zs[k + 1], u);
   }
+  return ring_z;
+}
 
-  Arm arm;
-  SkinnedMesh& m = arm.mesh;
-  const auto nv = static_cast<Eigen::Index>(vcount);
+// Rest positions (= current) and UVs: the south pole, the rings, the north pole.
+void arm_vertices(const Profile& p, const std::vector<double>& ring_z, int segments,
+                  Eigen::Index nv, SkinnedMesh& m) {
+  const auto rings = static_cast<int>(ring_z.size());
   m.rest.resize(3, nv);
   m.uvs.resize(2, nv);
   m.rest.col(0) = Eigen::Vector3d(0, 0, p.z_min());
@@ -137,9 +124,11 @@ Arm make_arm(const ArmOptions& o) {
   m.rest.col(nv - 1) = Eigen::Vector3d(0, 0, p.tip);
   m.uvs.col(nv - 1) = Eigen::Vector2d(0.5, 1);
   m.current = m.rest;
+}
 
-  // Faces. Along a ring j runs counter-clockwise seen from +z, so (a, b, c) with b the next
-  // vertex around and c the next ring up has normal ∝ (b − a) × (c − a) ≈ φ̂ × ẑ = outward.
+// Faces. Along a ring j runs counter-clockwise seen from +z, so (a, b, c) with b the next
+// vertex around and c the next ring up has normal ∝ (b − a) × (c − a) ≈ φ̂ × ẑ = outward.
+void arm_faces(int rings, int segments, Eigen::Index nv, SkinnedMesh& m) {
   auto idx = [segments](int ring, int seg) {
     return static_cast<std::int32_t>(1 + static_cast<long long>(ring) * segments +
                                      (seg % segments));
@@ -155,19 +144,24 @@ Arm make_arm(const ArmOptions& o) {
     }
   for (int j = 0; j < segments; ++j)
     m.faces.push_back({north, idx(rings - 1, j), idx(rings - 1, j + 1)});
+}
 
-  // Area-weighted vertex normals.
-  m.normals = Eigen::Matrix3Xd::Zero(3, nv);
+// Area-weighted vertex normals.
+void arm_normals(SkinnedMesh& m) {
+  m.normals = Eigen::Matrix3Xd::Zero(3, m.rest.cols());
   for (const Face& f : m.faces) {
     const Eigen::Vector3d n =
         (m.rest.col(f[1]) - m.rest.col(f[0])).cross(m.rest.col(f[2]) - m.rest.col(f[0]));
     for (int k = 0; k < 3; ++k) m.normals.col(f[k]) += n;
   }
   m.normals.colwise().normalize();
+}
 
-  // Weights: s_e rises from 0 to 1 across the elbow, s_w across the wrist;
-  // w_upper = 1 − s_e, w_fore = s_e (1 − s_w), w_hand = s_e s_w (sum 1, at most two non-zero
-  // while the transitions do not overlap). Sorted decreasing into the 4 slots.
+// Weights: s_e rises from 0 to 1 across the elbow, s_w across the wrist;
+// w_upper = 1 − s_e, w_fore = s_e (1 − s_w), w_hand = s_e s_w (sum 1, at most two non-zero
+// while the transitions do not overlap). Sorted decreasing into the 4 slots.
+void arm_weights(const Profile& p, const ArmOptions& o, SkinnedMesh& m) {
+  const Eigen::Index nv = m.rest.cols();
   m.bones = Eigen::Matrix<std::int32_t, kMaxInfluences, Eigen::Dynamic>::Zero(kMaxInfluences, nv);
   m.weights = Eigen::Matrix<double, kMaxInfluences, Eigen::Dynamic>::Zero(kMaxInfluences, nv);
   for (Eigen::Index v = 0; v < nv; ++v) {
@@ -185,10 +179,11 @@ Arm make_arm(const ArmOptions& o) {
         ++slot;
       }
   }
+}
 
-  // Skeleton: joints at the shoulder (origin), elbow and wrist along +z; each bone's offset is
-  // the inverse of its joint's bind placement (a translation by −z_joint).
-  auto& sk = arm.skeleton;
+// Skeleton: joints at the shoulder (origin), elbow and wrist along +z; each bone's offset is
+// the inverse of its joint's bind placement (a translation by −z_joint).
+void arm_skeleton(const Profile& p, skin::Skeleton& sk) {
   const double joint_z[3] = {0, p.elbow, p.wrist};
   for (int j = 0; j < 3; ++j) {
     skin::Joint joint;
@@ -204,6 +199,33 @@ Arm make_arm(const ArmOptions& o) {
         cga::Motor<double>::from_translation(Eigen::Vector3d(0, 0, -joint_z[j])));
     sk.bones.push_back(bone);
   }
+}
+
+}  // namespace
+
+Arm make_arm(const ArmOptions& o) {
+  if (!(o.upper_arm > 0) || !(o.forearm > 0) || !(o.hand > 0) || !(o.elbow_blend > 0) ||
+      !(o.wrist_blend > 0))
+    throw std::invalid_argument("make_arm: lengths and blend widths must be positive");
+  if (o.segments <= 0 && o.resolution < 1)
+    throw std::invalid_argument("make_arm: resolution must be at least 1");
+  const int segments = o.segments > 0 ? o.segments : 32 * o.resolution;
+  const int rings = o.rings > 0 ? o.rings : 80 * o.resolution;
+  if (segments < 3 || rings < 2)
+    throw std::invalid_argument("make_arm: need at least 3 segments and 2 rings");
+  const long long vcount = static_cast<long long>(rings) * segments + 2;
+  if (vcount > (1ll << 30)) throw std::invalid_argument("make_arm: resolution too large");
+
+  const double scale = (o.upper_arm + o.forearm) / 0.55;  // 1 for the default arm
+  const Profile p{o.upper_arm, o.upper_arm + o.forearm, o.upper_arm + o.forearm + o.hand,
+                  0.048 * scale, std::min(0.025 * scale, 0.45 * o.hand)};
+  Arm arm;
+  const auto nv = static_cast<Eigen::Index>(vcount);
+  arm_vertices(p, ring_heights(p, rings), segments, nv, arm.mesh);
+  arm_faces(rings, segments, nv, arm.mesh);
+  arm_normals(arm.mesh);
+  arm_weights(p, o, arm.mesh);
+  arm_skeleton(p, arm.skeleton);
   return arm;
 }
 

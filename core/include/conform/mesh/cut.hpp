@@ -48,10 +48,6 @@
 
 namespace conform::mesh {
 
-/// Which predicates classify vertices and intersect edges: the conformal inner product
-/// X·Π with X = up(x), or the plain Euclidean n·x − d (kept for the paper's Table 1).
-enum class Predicates { Cga, Euclidean };
-
 /// The cut's sliver floor θ_floor (radians): see CutOptions::min_angle.
 inline constexpr double kCutMinAngle = 5.0 * 3.14159265358979323846 / 180;
 
@@ -60,7 +56,6 @@ struct CutOptions {
   double snap_fraction = 0.01;      // of an edge's length
   double min_angle = kCutMinAngle;  // sliver floor θ_floor, radians, in [0, 0.5); 0: off
   bool cap = false;
-  Predicates predicates = Predicates::Cga;
   SectionTriangulator cap_triangulator = SectionTriangulator::Best;
 };
 
@@ -78,10 +73,6 @@ struct CutResult {
   std::int32_t cap_faces = 0;     // per side
   std::string message;            // why a loop was not capped, when one was not
 };
-
-/// Step 1 alone (exposed for benchmarks): signed distances of the current positions.
-void classify_vertices(const SkinnedMesh& mesh, const cga::Plane<double>& plane,
-                       Predicates predicates, std::vector<double>& distance);
 
 /// Computes the change without touching the mesh. O(V + F) for the classification, then
 /// proportional to the faces near the plane; the working arrays are kept per thread between

@@ -2,7 +2,7 @@
 //
 // The drill is a cylinder of radius r about the axis from B (base) to A (tip).
 //   1. the faces pierced by the axis segment B→A are found by a segment query of a FaceIndex
-//      (FaceSearch::Scan: by one scan of every face, the oracle of tests and benchmarks);
+//      (without one: by one scan of every face, also the oracle of tests and benchmarks);
 //   2. from each, a breadth-first walk over neighbouring faces that come within r of the
 //      axis (a vertex inside, or an edge whose projection on the plane Π through B
 //      perpendicular to the axis passes inside the disc) marks the affected patch; separate
@@ -108,7 +108,6 @@ struct DrillOptions {
   // apart (0: none, one triangle spans the wall). Ring vertices are new vertices on the
   // segments between the two rims (NewVertex::on_edge of rim vertices).
   double tube_ring_spacing = 0;
-  FaceSearch search = FaceSearch::Index;
 };
 
 struct DrillResult {

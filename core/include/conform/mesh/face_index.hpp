@@ -57,14 +57,10 @@ bool segment_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const 
                       std::array<double, 3>& bary);
 
 /// Every face the segment meets, by one scan of all faces, sorted by (t, face). O(F). The
-/// brute-force oracle of FaceIndex (tests, benchmarks, FaceSearch::Scan).
+/// brute-force oracle of FaceIndex (tests, benchmarks), and how the tear and the drill search
+/// when they are given no index.
 std::vector<SegmentHit> scan_segment_hits(const SkinnedMesh& mesh, const Eigen::Vector3d& p,
                                           const Eigen::Vector3d& q);
-
-/// How an operation finds the faces a segment meets: through a FaceIndex (the default), or
-/// by one scan of every face (the former behaviour, kept as an oracle for tests and for the
-/// benchmarks' same-run comparison).
-enum class FaceSearch { Index, Scan };
 
 class FaceIndex {
  public:

@@ -19,8 +19,7 @@
 // refits it before its query if it was marked moved (FaceIndex::ensure_fitted), updates it for
 // every change it applies, and marks it moved when open() moves positions, so it stays in sync.
 // Without one, each start attempt scans every face once (O(F), cheaper than building an index
-// for one query): keep an index for haptic rates. TearOptions::search = FaceSearch::Scan scans
-// even when an index is given (the oracle of tests and benchmarks).
+// for one query): keep an index for haptic rates.
 // Every step is one or two TopologyChanges (insert, then separate), applied at once and
 // returned so a soft body can mirror them. New vertices carry weights, UVs and normals as
 // described in topology_change.hpp.
@@ -66,7 +65,6 @@ struct TearOptions {
   double snap_fraction = 0.05;       // of an edge (and barycentric margin of the tip in its face)
   double min_angle = kTearMinAngle;  // sliver floor θ_floor, radians, in [0, 0.5)
   int max_walk_faces = 100000;       // bound of one step's walk
-  FaceSearch search = FaceSearch::Index;  // how the start finds the blade's first hit
 };
 
 struct TearStep {
@@ -100,6 +98,7 @@ class Tear {
   const std::string& message() const { return message_; }
 
  private:
+  friend class TearAdvance;  // the steps of advance() after the start (tear.cpp)
   struct PathVertex {
     std::int32_t right = -1;  // the original vertex (faces right of the path)
     std::int32_t left = -1;   // its duplicate for the faces on the left, −1 at the ends

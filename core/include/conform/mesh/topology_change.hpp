@@ -72,10 +72,31 @@ struct TopologyChange {
 /// change does not validate or was computed for a mesh of other counts.
 void apply(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency = nullptr);
 
-/// The two halves of apply(), without its validation, for timing them separately (weights
-/// and attributes of the new vertices; face slots). apply_vertices must run first.
-void apply_vertices(SkinnedMesh& mesh, const TopologyChange& change);
-void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency);
+/// The face-slot rule (steps 1–3 above), written once for every copy of the faces that has to
+/// follow a change: the mesh (apply), FaceIndex::update, face_after, added_face_indices, the
+/// plugin's soft body. Calls, in order,
+///   visitor.fill(slot, k)     step 1: added face k overwrites removed slot `slot`;
+///   visitor.append(slot, k)   step 2: added face k is appended as face `slot`;
+///   visitor.move(last, slot)  step 3: the last face moves into the removed slot (slot < last),
+///   visitor.pop(last)         step 3: then the last slot is dropped (also when it was the
+///                             removed slot itself).
+/// `slot` and `last` are face indices of the copy at that moment, starting from
+/// base_face_count faces. A slot filled in step 1 is below every slot of step 3, so the added
+/// faces never move: added face k ends at the slot of its fill() or append().
+template <class Visitor>
+void visit_face_slots(const TopologyChange& change, Visitor&& visitor) {
+  const auto& removed = change.removed_faces;
+  const std::size_t added = change.added_faces.size();
+  const std::size_t filled = removed.size() < added ? removed.size() : added;
+  for (std::size_t k = 0; k < filled; ++k) visitor.fill(removed[k], k);
+  std::int32_t count = change.base_face_count;
+  for (std::size_t k = filled; k < added; ++k) visitor.append(count++, k);
+  for (std::size_t k = removed.size(); k-- > filled;) {
+    const std::int32_t slot = removed[k], last = --count;
+    if (slot != last) visitor.move(last, slot);
+    visitor.pop(last);
+  }
+}
 
 /// §4.3: blends up to three vertices' (bones, weights) with `coefficients`, keeps the 4
 /// largest, renormalizes; writes column `out` of mesh.bones / mesh.weights.
