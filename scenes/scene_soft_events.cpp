@@ -375,6 +375,10 @@ class Character final : public Scene {
     units_ = model.number("units_per_metre", 1, 1e-6, 1e6);
     model.finish();
     bullet::Material d;
+    // Real characters come at any scale (units_per_metre) and their animations stretch the
+    // skin far from the bind pose; the SI membrane on them is not validated yet, so this scene
+    // keeps Bullet's soft links (material.model = "membrane" to try it).
+    d.model = bullet::MaterialModel::bullet_links;
     d.kinematic_weight = 0.95;  // nodes near one bone ride it; blended regions jiggle
     // The animation stretches the skin (edge lengths change), which stiff links at bind-pose
     // rest lengths would fight: soft links, and a firm pull toward the skinned targets.

@@ -28,7 +28,7 @@ int main() {
   conform::bullet::Plugin plugin(world);
   const conform::mesh::Arm arm = conform::mesh::make_arm(1);  // 2562 vertices, 3 bones
   conform::bullet::Material material;
-  material.pretension = 0.1;  // 10 % pre-stretched skin: wounds open by themselves
+  material.skin.prestress = {80.8e3, 80.8e3};  // Pa: wounds open by themselves
   auto& skin = plugin.add_skinned_body(arm.mesh, arm.skeleton, material);
 
   // Keyframes made on the fly: bend the elbow by 1 rad over one second.
