@@ -262,9 +262,59 @@ void BM_OpeningTearStep(benchmark::State& state) {
 }
 BENCHMARK(BM_OpeningTearStep)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
+// The default material against today's baseline (Bullet's links, the tear-opening scene's link
+// settings) in the same run: the arm of `resolution` (1: 2.6k vertices, 2: 10k), its forearm
+// torn open (40 samples) and settled, then one 1/60 s step of 2 substeps while the elbow
+// flexes (a moving pose, so the membrane solves every substep).
+void BM_StepTornArm(benchmark::State& state) {
+  const bool membrane = state.range(0) == 1;
+  const mesh::Arm arm = mesh::make_arm(int(state.range(1)));
+  SoftWorld w;
+  bullet::Plugin plugin(w.world);
+  bullet::Material material;
+  if (!membrane)
+    material = {.model = bullet::MaterialModel::bullet_links,
+                .damping = 0.02,
+                .pretension = 0.2,
+                .target_stiffness = 4000,
+                .target_damping = 40,
+                .kinematic_weight = 2};
+  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, material);
+  skin::PoseTrack track;
+  track.set_key(0, skin::Pose::rest(arm.skeleton));
+  track.set_key(60, conform::test::bent_arm_pose(arm.skeleton, 0.0, 1.5));
+  body.set_keyframes(track);
+  body.begin_tear();
+  for (int i = 0; i < 40; ++i) {
+    const double z = 0.3712 + 0.12 * i / 39;
+    body.tear_advance({double(i), {0.09, 0.0023, z}, {0.005, 0.0023, z}});
+  }
+  const auto step = [&] { w.bullet::SoftWorld::step(1.0 / 120, 2); };
+  for (int i = 0; i < 30; ++i) step();
+  for (auto _ : state) step();
+  state.counters["nodes"] = body.vertex_count();
+  state.counters["newton"] = body.last_solve().newton_iterations;
+  state.counters["cg"] = body.last_solve().cg_iterations;
+  state.counters["realtime_x"] =
+      benchmark::Counter(double(state.iterations()) / 60, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_StepTornArm)
+    ->ArgNames({"membrane", "res"})
+    ->Args({1, 1})
+    ->Args({0, 1})
+    ->Args({1, 2})
+    ->Args({0, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  for (const char* r : {"1", "2"})
+    conform::bench::add_ratio(
+        std::string("BM_StepTornArm/membrane:1/res:") + r + "/min_time:2.000",
+        std::string("BM_StepTornArm/membrane:0/res:") + r + "/min_time:2.000",
+        std::string("membrane / Bullet links (today's default), torn arm, resolution ") + r);
   for (const char* s : {"5", "0"}) {
     const std::string base = std::string("BM_StepUnskinned/") + s + "/min_time:1.000";
     conform::bench::add_ratio(std::string("BM_StepSkinned/") + s + "/min_time:1.000", base,
