@@ -278,3 +278,110 @@ TEST(Tear, StartsAtTheBladesFirstHit) {
   EXPECT_GT(s0.z(), 0.9);
   EXPECT_EQ(index.validate(m), "");
 }
+
+namespace {
+
+// Distance from p to the triangle (a, b, c) of the plane z = 0 (0 inside).
+double distance_2d(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                   const Eigen::Vector2d& c) {
+  auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    return u.x() * v.y() - u.y() * v.x();
+  };
+  const double s = cross(b - a, c - a), s1 = cross(b - a, p - a), s2 = cross(c - b, p - b),
+               s3 = cross(a - c, p - c);
+  if (s != 0 && s1 * s >= 0 && s2 * s >= 0 && s3 * s >= 0) return 0;
+  auto segment = [](const Eigen::Vector2d& q, const Eigen::Vector2d& x, const Eigen::Vector2d& y) {
+    const double l2 = (y - x).squaredNorm();
+    const double u = l2 > 0 ? std::clamp((q - x).dot(y - x) / l2, 0.0, 1.0) : 0.0;
+    return (x + u * (y - x) - q).norm();
+  };
+  return std::min({segment(p, a, b), segment(p, b, c), segment(p, c, a)});
+}
+
+double longest_edge(const SkinnedMesh& m) {
+  double l = 0;
+  for (const Face& f : m.faces)
+    for (int k = 0; k < 3; ++k)
+      l = std::max(l, (m.current.col(f[(k + 1) % 3]) - m.current.col(f[k])).norm());
+  return l;
+}
+
+}  // namespace
+
+TEST(Tear, AJumpAcrossASheetStaysInTheSweptRegion) {
+  // On a flat sheet Π ∩ M runs straight from the tip to the blade: however far the blade
+  // jumps, the path lies in the region it swept (here the triangle of the tip and the two
+  // vertical blades), within the tolerance.
+  const SkinnedMesh in = make_sheet(40, 40);
+  SkinnedMesh m = in;
+  Adjacency adj(m);
+  Tear tear(m, adj);
+  const Eigen::Vector2d from(-0.3, -0.2), to(0.25, 0.3);
+  ASSERT_TRUE(tear.advance(vertical(0, from.x(), from.y())).changes.size() == 1);
+  const std::int32_t before = tear.path_length();
+  const Eigen::Vector2d tip = m.current.col(tear.right_border().back()).head<2>();
+  EXPECT_TRUE(tear.advance(vertical(1, to.x(), to.y())).extended) << tear.message();
+  EXPECT_GT(tear.path_length(), before + 10);
+  const double tolerance = TearOptions{}.sweep_tolerance * longest_edge(in);
+  double worst = 0;
+  for (const std::int32_t v : tear.right_border())
+    worst = std::max(worst, distance_2d(m.current.col(v).head<2>(), tip, from, to));
+  EXPECT_LE(worst, tolerance);
+  EXPECT_LT(worst, 0.25 * longest_edge(in));  // crossings kept off Π: 0.13 edge measured
+  expect_torn(m, in, tear, "sheet jump");
+}
+
+TEST(Tear, AWalkAroundACylinderWaitsForTheBlade) {
+  // The blade crosses the cylinder 48° clockwise of the tip, but its point nearest the tip
+  // lies counter-clockwise, so the walk from the tip sets off the long way round (300°, the
+  // tear-opening runaway): it leaves the swept region and the sample leaves the mesh as it is.
+  const SkinnedMesh in = make_cylinder(96, 30, 1.0, 2.0);
+  const double z = 1.0 + 1.0 / 30;  // between two rings
+  auto blade = [&](double t, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return ScalpelSample{t, {a.x(), a.y(), z}, {b.x(), b.y(), z}};
+  };
+  const ScalpelSample start = blade(0, {1.5, 0}, {0.5, 0});
+  const ScalpelSample far = blade(1, {0.6, -1.04}, {0.85, 0.45});
+  for (const bool bounded : {false, true}) {
+    SkinnedMesh m = in;
+    Adjacency adj(m);
+    TearOptions options;
+    if (!bounded) options.sweep_tolerance = std::numeric_limits<double>::infinity();
+    Tear tear(m, adj, options);
+    ASSERT_TRUE(tear.advance(start).changes.size() == 1);
+    const std::int32_t path = tear.path_length(), faces = m.face_count();
+    const TearStep step = tear.advance(far);
+    if (!bounded) {  // the runaway this bounds: the tear goes most of the way round
+      ASSERT_TRUE(step.extended) << tear.message();
+      EXPECT_GT(tear.length(), 4.0);
+      continue;
+    }
+    EXPECT_FALSE(step.extended);
+    EXPECT_TRUE(step.changes.empty());
+    EXPECT_EQ(tear.path_length(), path);
+    EXPECT_EQ(m.face_count(), faces);
+    EXPECT_NE(tear.message().find("the walk left the region the blade swept"), std::string::npos)
+        << tear.message();
+    // The blade moving on from there in short steps back toward the tip's side extends the tear
+    // the short way, within the region.
+    bool grew = false;
+    for (int i = 1; i <= 20 && !grew; ++i) {
+      const double a = -0.01 * i;
+      const Eigen::Vector2d d(std::cos(a), std::sin(a));
+      grew = tear.advance(blade(1 + i, 1.5 * d, 0.5 * d)).extended;
+    }
+    EXPECT_TRUE(grew) << tear.message();
+    EXPECT_LT(tear.length(), 0.5);
+    expect_torn(m, in, tear, "cylinder");
+  }
+}
+
+TEST(Tear, SweepToleranceMustBeNonNegative) {
+  SkinnedMesh m = make_sheet(4, 4);
+  Adjacency adj(m);
+  TearOptions o;
+  o.sweep_tolerance = -1;
+  EXPECT_THROW(Tear(m, adj, o), std::invalid_argument);
+  o.sweep_tolerance = std::nan("");
+  EXPECT_THROW(Tear(m, adj, o), std::invalid_argument);
+}

@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <stdexcept>
@@ -35,6 +37,57 @@ bool segment_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const 
                       std::array<double, 3>& bary) {
   double t = 0;
   return conform::mesh::segment_triangle(p, q, a, b, c, t, bary);
+}
+
+double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                        const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double l2 = ab.squaredNorm();
+  const double u = l2 > 0 ? std::clamp((p - a).dot(ab) / l2, 0.0, 1.0) : 0.0;
+  return (a + u * ab - p).norm();
+}
+
+// Distance from p to triangle (a, b, c): to its plane where p projects inside it, else to its
+// nearest edge (also when the triangle is degenerate).
+double triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                         const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+  const Eigen::Vector3d n = (b - a).cross(c - a);
+  const double n2 = n.squaredNorm();
+  if (n2 > 0 && n.dot((b - a).cross(p - a)) >= 0 && n.dot((c - b).cross(p - b)) >= 0 &&
+      n.dot((a - c).cross(p - c)) >= 0)
+    return std::abs(n.dot(p - a)) / std::sqrt(n2);
+  return std::min(
+      {segment_distance(p, a, b), segment_distance(p, b, c), segment_distance(p, c, a)});
+}
+
+double signed_volume(const std::array<Eigen::Vector3d, 4>& t) {
+  return (t[1] - t[0]).cross(t[2] - t[0]).dot(t[3] - t[0]);
+}
+
+// Distance from p to the convex hull of five points (0 inside). By Carathéodory the hull is the
+// union of the tetrahedra on four of the points, and its boundary lies on triangles of three
+// (which also covers a flat or collinear hull).
+double hull_distance(const Eigen::Vector3d& p, const std::array<Eigen::Vector3d, 5>& q) {
+  for (std::size_t skip = 0; skip < q.size(); ++skip) {
+    std::array<Eigen::Vector3d, 4> t;
+    for (std::size_t i = 0, k = 0; i < q.size(); ++i)
+      if (i != skip) t[k++] = q[i];
+    const double v = signed_volume(t);
+    if (v == 0) continue;
+    bool inside = true;
+    for (std::size_t f = 0; f < t.size() && inside; ++f) {
+      auto u = t;
+      u[f] = p;  // p on the same side of the face opposite t[f] as t[f]
+      inside = signed_volume(u) * v >= 0;
+    }
+    if (inside) return 0;
+  }
+  double d = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < q.size(); ++i)
+    for (std::size_t j = i + 1; j < q.size(); ++j)
+      for (std::size_t k = j + 1; k < q.size(); ++k)
+        d = std::min(d, triangle_distance(p, q[i], q[j], q[k]));
+  return d;
 }
 
 // The faces around vertex v, starting from half-edge h out of v (CCW, then CW from h if a
@@ -169,7 +222,23 @@ class TearAdvance {
     const double u =
         std::clamp((tip_ - s_.a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
     toward_ = s_.a + u * ab - tip_;
+    sweep_ = {tip_, tear_.previous_.a, tear_.previous_.b, s_.a, s_.b};
     return true;
+  }
+
+  // The walk's latest point lies within sweep_tolerance (in edge lengths of its face) of the
+  // region the blade swept; else the first distance beyond it is kept for the message.
+  bool within_sweep(const Crossing& c) {
+    const double tolerance = tear_.options_.sweep_tolerance;
+    if (std::isinf(tolerance)) return true;
+    const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
+    double edge = 0;
+    for (int k = 0; k < 3; ++k)
+      edge = std::max(edge, (mesh_.current.col(f[(k + 1) % 3]) - mesh_.current.col(f[k])).norm());
+    const double d = hull_distance(pos(c.out, c.face), sweep_);
+    if (d <= tolerance * edge) return true;
+    if (beyond_ < 0) beyond_ = d;
+    return false;
   }
 
   double delta(std::int32_t v) const {
@@ -272,6 +341,15 @@ class TearAdvance {
       if (m.cosine <= 0) break;
       walk_from(m);
     }
+    if (path_.empty() && beyond_ >= 0) {
+      char text[128];
+      std::snprintf(text, sizeof text,
+                    "the walk left the region the blade swept (%.3g m beyond it): waiting for "
+                    "the blade",
+                    beyond_);
+      tear_.message_ = text;
+      return false;
+    }
     if (path_.empty()) {
       tear_.message_ =
           "the walk from the tip did not reach the blade (outside the mesh, unmoved, or past a "
@@ -307,10 +385,12 @@ class TearAdvance {
   void walk_from(const Move& m) {
     std::vector<Crossing> trial{{m.face, {PathPoint::Vertex, tear_.tip_}, m.out}};
     std::vector<std::int32_t> visited{m.face};
+    if (!within_sweep(trial.back())) return;
     for (int guard = 0; guard < tear_.options_.max_walk_faces; ++guard) {
       const WalkStep next = trial.back().out.kind == PathPoint::Edge ? cross_edge(trial, visited)
                                                                      : pass_vertex(trial, visited);
       if (next == WalkStep::Failed) return;
+      if (next == WalkStep::Moved && !within_sweep(trial.back())) return;  // left the sweep
       if (next == WalkStep::Reached) {
         path_ = std::move(trial);
         return;
@@ -600,7 +680,9 @@ class TearAdvance {
   // Step 1
   Eigen::Vector3d tip_, n_, toward_;
   cga::Plane<double> plane_;
-  double zero_ = 0;  // |distance to Π| taken as on it
+  double zero_ = 0;                       // |distance to Π| taken as on it
+  std::array<Eigen::Vector3d, 5> sweep_;  // the tip and both blades: their hull is the sweep
+  double beyond_ = -1;                    // how far a walk left the sweep (−1: none did)
   // Step 2
   std::vector<Crossing> path_;
   // Step 3
@@ -625,6 +707,8 @@ Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, const TearOptions& options)
       !(options.min_angle >= 0 && options.min_angle < 0.5))
     throw std::invalid_argument(
         "tear: snap_fraction must be in (0, 0.25) and min_angle in [0, 0.5)");
+  if (!(options.sweep_tolerance >= 0))
+    throw std::invalid_argument("tear: sweep_tolerance must be ≥ 0 (infinity: unbounded)");
 }
 
 Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex& index, const TearOptions& options)
@@ -690,6 +774,7 @@ TearStep Tear::advance(const ScalpelSample& s) {
   TearStep step;
   if (tip_ < 0) {
     start(s, step);
+    previous_ = s;
     return step;
   }
   // The index inserts only the faces that survive both phases of the step.
@@ -702,6 +787,7 @@ TearStep Tear::advance(const ScalpelSample& s) {
   } batch{index_, mesh_};
   if (index_) index_->begin_batch();
   TearAdvance(*this, s, step).run();
+  previous_ = s;
   return step;
 }
 
