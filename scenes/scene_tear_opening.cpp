@@ -365,7 +365,7 @@ class TearOpening final : public Scene {
     Plot side{"profiles", "tear-opening: gap-width profile along the tear over time", "", "", {},
               {}};
     Plot left{"",
-              "physics (pre-tensioned soft body)",
+              "physics (pre-stressed skin membrane in Bullet)",
               "position along the tear (0 = start, 1 = tip)",
               "gap width [m]",
               {},
