@@ -99,9 +99,9 @@ struct Material {
   /// Collision margin of the pieces, m.
   double margin = 0.005;
   /// membrane: the skin's material (SI units, sourced defaults for human skin).
-  membrane::SkinMaterial skin;
+  membrane::SkinMaterial skin{};
   /// membrane: the solve of each substep (tolerance in Pa of nodal traction).
-  membrane::SolverSettings solver;
+  membrane::SolverSettings solver{};
 };
 
 /// What one applied TopologyChange did to the Bullet side.
