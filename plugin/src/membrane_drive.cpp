@@ -2,6 +2,8 @@
 
 #include <BulletSoftBody/btSoftBody.h>
 
+#include "conform/bullet/convert.hpp"
+
 namespace conform::bullet {
 
 void MembraneDrive::target_normals(const mesh::SkinnedMesh& mesh,
@@ -24,6 +26,13 @@ membrane::SolveReport MembraneDrive::step(
     const Eigen::Ref<const Eigen::Matrix3Xd>& targets,
     const Eigen::Ref<const Eigen::Matrix3Xd>& previous_targets, double dt) {
   const Eigen::Index nv = mesh.vertex_count();
+  // The last solution in double precision carries over while the mesh is unchanged. Bullet
+  // keeps btScalar positions, and in single precision their rounding alone (~1e-7 of the arm's
+  // size) leaves a residual of 10-40 Pa, above the tolerance: a body at rest would be solved
+  // again every substep. A node that Bullet left where it was written continues from the
+  // unrounded value (its prediction shifted by the same amount); one that Bullet moved (a
+  // contact) continues from Bullet's position.
+  const bool carry = !stale_ && solution_.cols() == nv;
   if (stale_ || model_.vertex_count() != nv) {
     model_.build(mesh.rest, mesh.faces, material);
     stale_ = false;
@@ -40,8 +49,12 @@ membrane::SolveReport MembraneDrive::step(
       fixed_[std::size_t(v)] = 1;
       continue;
     }
-    predicted_.col(v) = Eigen::Vector3d(node->m_x.x(), node->m_x.y(), node->m_x.z());
-    start_.col(v) = Eigen::Vector3d(node->m_q.x(), node->m_q.y(), node->m_q.z());
+    predicted_.col(v) = from_bt(node->m_x);
+    start_.col(v) = from_bt(node->m_q);
+    if (carry && node->m_q == to_bt(solution_.col(v))) {
+      predicted_.col(v) += solution_.col(v) - start_.col(v);
+      start_.col(v) = solution_.col(v);
+    }
     // Initial guess: the last solution carried along by its target; near the equilibrium
     // (where it balances gravity and the membrane) this is within the tolerance already,
     // while Bullet's prediction (+ g dt^2) is not.
@@ -52,10 +65,11 @@ membrane::SolveReport MembraneDrive::step(
   const membrane::StepInput input{targets, normals_, start_,     velocity_,
                                   fixed_,  dt,       predicted_, masses};
   report_ = solver_.solve(model_, input, settings, x_);
+  solution_ = x_;
   for (Eigen::Index v = 0; v < nv; ++v) {
     if (fixed_[std::size_t(v)]) continue;
     auto* node = static_cast<btSoftBody::Node*>(nodes[std::size_t(v)]);
-    node->m_x = btVector3(btScalar(x_(0, v)), btScalar(x_(1, v)), btScalar(x_(2, v)));
+    node->m_x = to_bt(x_.col(v));
     node->m_v = (node->m_x - node->m_q) / btScalar(dt);
   }
   return report_;

@@ -44,6 +44,7 @@ class MembraneDrive {
   membrane::SolveReport report_;
   bool stale_ = true;
   Eigen::Matrix3Xd x_, start_, predicted_, velocity_, normals_;
+  Eigen::Matrix3Xd solution_;  // the last solve's result, unrounded (empty after a change)
   std::vector<std::uint8_t> fixed_;
 };
 
