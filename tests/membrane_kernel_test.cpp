@@ -84,6 +84,9 @@ TEST(MembraneKernel, HessianActionIsTheDerivativeOfTheGradientInTension) {
           const Eigen::Matrix3d k = detail::hessian_block(e, s, model.lambda(), model.mu(), a, b);
           const Eigen::Vector3d column = a == 0 ? o0 : a == 1 ? o1 : o2;
           EXPECT_LT((k.col(axis) - column).norm(), 1e-9 * k.norm() + 1e-12);
+          Eigen::Matrix3d row[3];  // the solver's assembly: row a's three blocks at once
+          detail::hessian_row(e, s, model.lambda(), model.mu(), a, row);
+          EXPECT_LT((row[b] - k).norm(), 1e-12 * k.norm() + 1e-15);
         }
       }
   }

@@ -34,14 +34,19 @@ void SolverSettings::validate() const {
   if (threads < 1) fail("threads", threads, ">= 1");
   if (!(cg_relative_tolerance > 0 && cg_relative_tolerance < 1))
     fail("cg_relative_tolerance", cg_relative_tolerance, "(0, 1)");
+  if (!(local_fraction >= 0 && local_fraction < 1))
+    fail("local_fraction", local_fraction, "[0, 1)");
+  if (!(local_reach > 0) || !std::isfinite(local_reach)) fail("local_reach", local_reach, "> 0");
 }
 
 struct Solver::Scratch {
   std::vector<detail::ElementState> states_;
   std::vector<Eigen::Matrix3d> node_stiffness_, block_inverse_, blocks_;
-  std::vector<std::uint8_t> free_;  // per vertex: moves in this solve
+  std::vector<std::uint8_t> free_;    // per vertex: may move in this solve
+  std::vector<std::uint8_t> active_;  // per vertex: moves in this Newton step (a subset of free_)
+  std::vector<std::int32_t> reached_, seed_of_;  // the active set's search (select_active)
   Eigen::Matrix3Xd predicted_, gradient_, step_, r_, z_, p_, q_, trial_;
-  Eigen::VectorXd inertia_weight_;
+  Eigen::VectorXd inertia_weight_, node_residual_;
 };
 
 Solver::Solver() : scratch_(std::make_unique<Scratch>()) {}
@@ -148,46 +153,102 @@ void gather_gradient(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x, Ei
   }
 }
 
-double residual(const Context& c, const Eigen::Matrix3Xd& g) {
+// The residual of each free node (|g_i| / A_i, Pa; 0 at fixed nodes) and the largest.
+double residual(Context& c, const Eigen::Matrix3Xd& g) {
   double worst = 0;
-  for (std::int64_t v = 0; v < c.nv; ++v)
-    if (!c.fixed(v)) worst = std::max(worst, g.col(v).norm() / c.model.node_area(std::int32_t(v)));
+  c.s.node_residual_.setZero(c.nv);
+  for (std::int64_t v = 0; v < c.nv; ++v) {
+    if (!c.s.free_[std::size_t(v)]) continue;
+    c.s.node_residual_[v] = g.col(v).norm() / c.model.node_area(std::int32_t(v));
+    worst = std::max(worst, c.s.node_residual_[v]);
+  }
   return worst;
 }
 
-// Phase 4: assemble the Hessian approximation's 3 x 3 blocks (element blocks, then the nodal
-// attachment and inertia terms on the diagonal) and invert the diagonal blocks (block-Jacobi).
-// Rows and columns of fixed nodes are left out by hessian_apply.
+// Phase 4: the nodes this Newton step moves. Right after an edit the imbalance is large and
+// local (a crack tip: 1e5 Pa there, below the tolerance elsewhere), and a step over the whole
+// mesh would spend its conjugate-gradient iterations on nodes that are in balance. So the step
+// moves the free nodes within `local_reach` decay lengths sqrt(E t / k_t) (the distance over
+// which the attachment screens a load) of a node whose residual exceeds
+// max(tolerance, local_fraction * worst). The stopping test stays global, so the solution is
+// the same; as the imbalance falls toward the tolerance the active set grows to wherever one
+// remains.
+void select_active(Context& c, double worst, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+  Solver::Scratch& s = c.s;
+  const SkinMaterial& m = c.model.material();
+  const double decay = std::sqrt(m.youngs_modulus * m.thickness / m.attachment_stiffness);
+  const double reach = c.settings.local_reach * decay;
+  if (!(c.settings.local_fraction > 0) || !std::isfinite(reach)) {
+    s.active_ = s.free_;
+    return;
+  }
+  const double threshold = std::max(c.settings.tolerance, c.settings.local_fraction * worst);
+  s.active_.assign(std::size_t(c.nv), 0);
+  s.seed_of_.assign(std::size_t(c.nv), -1);
+  s.reached_.clear();
+  for (std::int64_t v = 0; v < c.nv; ++v)
+    if (s.node_residual_[v] > threshold) {
+      s.active_[std::size_t(v)] = 1;
+      s.seed_of_[std::size_t(v)] = std::int32_t(v);
+      s.reached_.push_back(std::int32_t(v));
+    }
+  // Breadth first over the Hessian's graph, each node keeping the seed it was reached from.
+  const auto& start = c.model.block_start();
+  const auto& column = c.model.block_column();
+  for (std::size_t k = 0; k < s.reached_.size(); ++k) {
+    const std::int32_t v = s.reached_[k], seed = s.seed_of_[std::size_t(v)];
+    for (std::int32_t j = start[std::size_t(v)]; j < start[std::size_t(v) + 1]; ++j) {
+      const std::int32_t u = column[std::size_t(j)];
+      if (s.seed_of_[std::size_t(u)] >= 0 || !s.free_[std::size_t(u)]) continue;
+      if ((x.col(u) - x.col(seed)).norm() > reach) continue;
+      s.seed_of_[std::size_t(u)] = seed;
+      s.active_[std::size_t(u)] = 1;
+      s.reached_.push_back(u);
+    }
+  }
+}
+
+// Phase 5: assemble the Hessian approximation's 3 x 3 blocks of the active rows, each row
+// gathering from the elements it is a corner of (no two rows write one block, so the rows run
+// in parallel), then the nodal attachment and inertia terms on the diagonal; and invert the
+// diagonal blocks (block-Jacobi). Columns of inactive nodes are left out by hessian_apply.
 void assemble(Context& c) {
   const auto& elements = c.model.elements();
   const auto& element_block = c.model.element_block();
   const auto& diagonal = c.model.diagonal_block();
+  const auto& row_start = c.model.block_start();
+  const auto& start = c.model.incidence_start();
+  const auto& inc = c.model.incidence();
   const double lambda = c.model.lambda(), mu = c.model.mu();
-  c.s.blocks_.assign(c.model.block_column().size(), Eigen::Matrix3d::Zero());
-  for (std::int64_t e = 0; e < c.ne; ++e) {
-    const detail::ElementRest& rest = elements[std::size_t(e)];
-    const detail::ElementState& state = c.s.states_[std::size_t(e)];
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b)
-        c.s.blocks_[std::size_t(element_block[std::size_t(9 * e + 3 * a + b)])] +=
-            detail::hessian_block(rest, state, lambda, mu, a, b);
-  }
+  c.s.blocks_.resize(c.model.block_column().size());
   c.s.block_inverse_.resize(static_cast<std::size_t>(c.nv));
+#pragma omp parallel for schedule(static) \
+    num_threads(c.threads) if (c.threads > 1 && c.ne > kParallelElements)
   for (std::int64_t v = 0; v < c.nv; ++v) {
-    Eigen::Matrix3d& k = c.s.blocks_[std::size_t(diagonal[std::size_t(v)])];
-    k += c.s.node_stiffness_[std::size_t(v)];
-    if (c.dynamic) k.diagonal().array() += c.s.inertia_weight_[v];
-    if (c.fixed(v)) {
-      c.s.block_inverse_[std::size_t(v)].setZero();
+    Solver::Scratch& s = c.s;
+    if (!s.active_[std::size_t(v)]) {
+      s.block_inverse_[std::size_t(v)].setZero();
       continue;
     }
+    for (std::int32_t j = row_start[std::size_t(v)]; j < row_start[std::size_t(v) + 1]; ++j)
+      s.blocks_[std::size_t(j)].setZero();
+    for (std::int32_t k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
+      const std::int32_t e = inc[std::size_t(k)] / 3, a = inc[std::size_t(k)] % 3;
+      Eigen::Matrix3d row[3];
+      detail::hessian_row(elements[std::size_t(e)], s.states_[std::size_t(e)], lambda, mu, a, row);
+      for (int b = 0; b < 3; ++b)
+        s.blocks_[std::size_t(element_block[std::size_t(9 * e + 3 * a + b)])] += row[b];
+    }
+    Eigen::Matrix3d& k = s.blocks_[std::size_t(diagonal[std::size_t(v)])];
+    k += s.node_stiffness_[std::size_t(v)];
+    if (c.dynamic) k.diagonal().array() += s.inertia_weight_[v];
     const Eigen::Matrix3d regular =
         k + (1e-12 * k.trace() + 1e-300) * Eigen::Matrix3d::Identity();  // a lone node
-    c.s.block_inverse_[std::size_t(v)] = regular.inverse();
+    s.block_inverse_[std::size_t(v)] = regular.inverse();
   }
 }
 
-// out = H d over the free nodes (d's fixed entries are read as zero, out's are zero).
+// out = H d over the active nodes (d's other entries are read as zero, out's are zero).
 void hessian_apply(Context& c, const Eigen::Matrix3Xd& d, Eigen::Matrix3Xd& out) {
   const auto& start = c.model.block_start();
   const auto& column = c.model.block_column();
@@ -196,13 +257,13 @@ void hessian_apply(Context& c, const Eigen::Matrix3Xd& d, Eigen::Matrix3Xd& out)
     num_threads(c.threads) if (c.threads > 1 && c.ne > kParallelElements)
   for (std::int64_t v = 0; v < c.nv; ++v) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    if (!c.s.free_[std::size_t(v)]) {
+    if (!c.s.active_[std::size_t(v)]) {
       out.col(v) = sum;
       continue;
     }
     for (std::int32_t j = start[std::size_t(v)]; j < start[std::size_t(v) + 1]; ++j) {
       const std::int32_t u = column[std::size_t(j)];
-      if (c.s.free_[std::size_t(u)]) sum += c.s.blocks_[std::size_t(j)] * d.col(u);
+      if (c.s.active_[std::size_t(u)]) sum.noalias() += c.s.blocks_[std::size_t(j)] * d.col(u);
     }
     out.col(v) = sum;
   }
@@ -213,15 +274,18 @@ void precondition(const Context& c, const Eigen::Matrix3Xd& r, Eigen::Matrix3Xd&
   for (std::int64_t v = 0; v < c.nv; ++v) z.col(v) = c.s.block_inverse_[std::size_t(v)] * r.col(v);
 }
 
-// Phase 5: H step = -g by preconditioned conjugate gradients; returns the iterations.
+// Phase 6: H step = -g over the active nodes by preconditioned conjugate gradients; returns
+// the iterations.
 int conjugate_gradients(Context& c, const Eigen::Matrix3Xd& g, Eigen::Matrix3Xd& step) {
   Solver::Scratch& s = c.s;
   step.setZero(3, c.nv);
-  s.r_ = -g;
+  s.r_.resize(3, c.nv);
+  for (std::int64_t v = 0; v < c.nv; ++v)
+    s.r_.col(v) = s.active_[std::size_t(v)] ? Eigen::Vector3d(-g.col(v)) : Eigen::Vector3d::Zero();
   precondition(c, s.r_, s.z_);
   s.p_ = s.z_;
   double rz = (s.r_.array() * s.z_.array()).sum();
-  const double stop = c.settings.cg_relative_tolerance * g.norm();
+  const double stop = c.settings.cg_relative_tolerance * s.r_.norm();
   int it = 0;
   while (it < c.settings.max_cg_iterations && s.r_.norm() > stop) {
     hessian_apply(c, s.p_, s.q_);
@@ -239,7 +303,7 @@ int conjugate_gradients(Context& c, const Eigen::Matrix3Xd& g, Eigen::Matrix3Xd&
   return it;
 }
 
-// Phase 6: backtracking (Armijo) line search on Phi; returns false if no decrease was found.
+// Phase 7: backtracking (Armijo) line search on Phi; returns false if no decrease was found.
 bool line_search(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x, const Eigen::Matrix3Xd& g,
                  const Eigen::Matrix3Xd& step, double phi) {
   const double slope = (g.array() * step.array()).sum();
@@ -295,6 +359,7 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
       break;
     }
     if (report.newton_iterations == settings.max_newton_iterations) break;
+    select_active(c, report.residual, x);
     assemble(c);
     report.cg_iterations += conjugate_gradients(c, s.gradient_, s.step_);
     if (!line_search(c, x, s.gradient_, s.step_, potential(c, x))) break;

@@ -31,6 +31,14 @@ struct SolverSettings {
   int max_cg_iterations = 400;
   /// Each Newton system is solved until its residual is below this fraction of the gradient.
   double cg_relative_tolerance = 0.05;
+  /// A Newton step moves only the free nodes near one whose residual exceeds
+  /// max(tolerance, local_fraction x the largest residual): after an edit the imbalance is
+  /// local, and the rest of the mesh is already in balance to far better than it. In [0, 1);
+  /// 0 moves every free node in every step. The stopping test is global either way.
+  double local_fraction = 1e-2;
+  /// ... where near is within local_reach decay lengths sqrt(E t / k_t) of the attachment
+  /// (the distance over which it screens a load: about 4 cm for the default skin), > 0.
+  double local_reach = 2;
   /// OpenMP threads for the element and node loops of large meshes (1: serial). The results do
   /// not depend on it (every sum is gathered per vertex in a fixed order).
   int threads = 1;

@@ -80,6 +80,7 @@ struct ElementState {
   Mat32 f;                // deformation gradient
   Eigen::Matrix2d s_pos;  // S+ (for the Hessian)
   Mat32 p;                // first Piola-Kirchhoff stress F S (for the gradient)
+  Eigen::Matrix3d ff;     // F F^T (shared by the element's nine Hessian blocks)
 };
 
 inline ElementState element_state(const ElementRest& e, const Eigen::Vector3d& x0,
@@ -90,6 +91,7 @@ inline ElementState element_state(const ElementRest& e, const Eigen::Vector3d& x
   const Eigen::Matrix2d stress = pk2_stress(e, green_strain(s.f), lambda, mu);
   s.p = s.f * stress;
   s.s_pos = positive_part(stress);
+  s.ff = s.f * s.f.transpose();
   return s;
 }
 
@@ -116,9 +118,25 @@ inline Eigen::Matrix3d hessian_block(const ElementRest& e, const ElementState& s
                                      double mu, int a, int b) {
   const Eigen::Vector2d ba = beta_of(e, a), bb = beta_of(e, b);
   const Eigen::Vector3d fa = s.f * ba, fb = s.f * bb;
-  return e.area_thickness * ((ba.dot(s.s_pos * bb)) * Eigen::Matrix3d::Identity() +
-                             mu * ba.dot(bb) * (s.f * s.f.transpose()) + mu * fb * fa.transpose() +
-                             lambda * fa * fb.transpose());
+  return e.area_thickness *
+         ((ba.dot(s.s_pos * bb)) * Eigen::Matrix3d::Identity() + mu * ba.dot(bb) * s.ff +
+          mu * fb * fa.transpose() + lambda * fa * fb.transpose());
+}
+
+/// Row a of the element's blocks, K_a0, K_a1, K_a2 (the formula of hessian_block, with the
+/// terms of corner a computed once): what a vertex gathers from each element it is corner a of.
+inline void hessian_row(const ElementRest& e, const ElementState& s, double lambda, double mu,
+                        int a, Eigen::Matrix3d* out) {
+  const Eigen::Vector2d ba = beta_of(e, a);
+  const Eigen::Vector3d fa = s.f * ba;
+  const Eigen::Vector2d sba = s.s_pos * ba;
+  for (int b = 0; b < 3; ++b) {
+    const Eigen::Vector2d bb = beta_of(e, b);
+    const Eigen::Vector3d fb = s.f * bb;
+    out[b].noalias() =
+        e.area_thickness * ((sba.dot(bb)) * Eigen::Matrix3d::Identity() + mu * ba.dot(bb) * s.ff +
+                            mu * fb * fa.transpose() + lambda * fa * fb.transpose());
+  }
 }
 
 }  // namespace conform::membrane::detail
