@@ -4,6 +4,7 @@
 #include <BulletSoftBody/btSoftBody.h>
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -266,55 +267,116 @@ BENCHMARK(BM_OpeningTearStep)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 // settings) in the same run: the arm of `resolution` (1: 2.6k vertices, 2: 10k), its forearm
 // torn open (40 samples) and settled, then one 1/60 s step of 2 substeps while the elbow
 // flexes (a moving pose, so the membrane solves every substep).
-void BM_StepTornArm(benchmark::State& state) {
-  const bool membrane = state.range(0) == 1;
-  const mesh::Arm arm = mesh::make_arm(int(state.range(1)));
+// The torn arm of tear-opening, as a membrane (its scene defaults: one 1/60 s substep a frame;
+// `threads` OpenMP threads in the solver) or as Bullet's pre-tensioned links (the previous
+// default: two substeps of 1/120 s). torn: the stroke is done and the arm bends slowly, so
+// every frame solves; otherwise the clock runs over the stroke itself, one tear step a frame.
+struct TornArm {
   SoftWorld w;
-  bullet::Plugin plugin(w.world);
-  bullet::Material material;
-  if (!membrane)
-    material = {.model = bullet::MaterialModel::bullet_links,
-                .damping = 0.02,
-                .pretension = 0.2,
-                .target_stiffness = 4000,
-                .target_damping = 40,
-                .kinematic_weight = 2};
-  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, material);
-  skin::PoseTrack track;
-  track.set_key(0, skin::Pose::rest(arm.skeleton));
-  track.set_key(60, conform::test::bent_arm_pose(arm.skeleton, 0.0, 1.5));
-  body.set_keyframes(track);
-  body.begin_tear();
-  for (int i = 0; i < 40; ++i) {
-    const double z = 0.3712 + 0.12 * i / 39;
-    body.tear_advance({double(i), {0.09, 0.0023, z}, {0.005, 0.0023, z}});
+  bullet::Plugin plugin{w.world};
+  bullet::SkinnedSoftBody* body = nullptr;
+  bool membrane;
+  int next = 0;  // the next of the stroke's 40 samples
+
+  TornArm(bool membrane_model, int resolution, int threads) : membrane(membrane_model) {
+    const mesh::Arm arm = mesh::make_arm(resolution);
+    bullet::Material material;
+    material.solver.threads = threads;
+    if (!membrane)
+      material = {.model = bullet::MaterialModel::bullet_links,
+                  .damping = 0.02,
+                  .pretension = 0.2,
+                  .target_stiffness = 4000,
+                  .target_damping = 40,
+                  .kinematic_weight = 2};
+    body = &plugin.add_skinned_body(arm.mesh, arm.skeleton, material);
+    skin::PoseTrack track;
+    track.set_key(0, skin::Pose::rest(arm.skeleton));
+    track.set_key(60, conform::test::bent_arm_pose(arm.skeleton, 0.0, 1.5));
+    body->set_keyframes(track);
+    body->begin_tear();
   }
-  const auto step = [&] { w.bullet::SoftWorld::step(1.0 / 120, 2); };
-  for (int i = 0; i < 30; ++i) step();
-  for (auto _ : state) step();
-  state.counters["nodes"] = body.vertex_count();
-  state.counters["newton"] = body.last_solve().newton_iterations;
-  state.counters["cg"] = body.last_solve().cg_iterations;
-  state.counters["realtime_x"] =
-      benchmark::Counter(double(state.iterations()) / 60, benchmark::Counter::kIsRate);
+  void tear(int samples) {
+    for (int end = std::min(40, next + samples); next < end; ++next) {
+      const double z = 0.3712 + 0.12 * next / 39;
+      body->tear_advance({double(next), {0.09, 0.0023, z}, {0.005, 0.0023, z}});
+    }
+  }
+  void frame() {
+    if (membrane)
+      w.bullet::SoftWorld::step(1.0 / 60, 1);
+    else
+      w.bullet::SoftWorld::step(1.0 / 120, 2);
+  }
+};
+
+void report_solve(benchmark::State& state, const TornArm& a, double simulated_per_iteration) {
+  state.counters["nodes"] = a.body->vertex_count();
+  state.counters["newton"] = a.body->last_solve().newton_iterations;
+  state.counters["realtime_x"] = benchmark::Counter(
+      double(state.iterations()) * simulated_per_iteration, benchmark::Counter::kIsRate);
+}
+
+void BM_StepTornArm(benchmark::State& state) {
+  TornArm a(state.range(0) == 1, int(state.range(1)), int(state.range(2)));
+  a.tear(40);
+  for (int i = 0; i < 30; ++i) a.frame();
+  for (auto _ : state) a.frame();
+  report_solve(state, a, 1.0 / 60);
 }
 BENCHMARK(BM_StepTornArm)
-    ->ArgNames({"membrane", "res"})
-    ->Args({1, 1})
-    ->Args({0, 1})
-    ->Args({1, 2})
-    ->Args({0, 2})
+    ->ArgNames({"membrane", "res", "threads"})
+    ->Args({1, 1, 1})
+    ->Args({1, 1, 2})
+    ->Args({0, 1, 1})
+    ->Args({1, 2, 1})
+    ->Args({1, 2, 2})
+    ->Args({0, 2, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->MinTime(2.0);
+
+// The stroke: 40 samples over 30 frames (0.5 s), an edit before every frame.
+void BM_TearArm(benchmark::State& state) {
+  std::unique_ptr<TornArm> a;
+  for (auto _ : state) {
+    state.PauseTiming();
+    a = std::make_unique<TornArm>(state.range(0) == 1, int(state.range(1)), int(state.range(2)));
+    a->frame();
+    state.ResumeTiming();
+    for (int f = 0; f < 30; ++f) {
+      a->tear(f % 3 == 2 ? 2 : 1);  // 20 x 1 + 10 x 2 = 40 samples in 30 frames
+      a->frame();
+    }
+  }
+  report_solve(state, *a, 0.5);
+}
+BENCHMARK(BM_TearArm)
+    ->ArgNames({"membrane", "res", "threads"})
+    ->Args({1, 1, 1})
+    ->Args({1, 1, 2})
+    ->Args({0, 1, 1})
+    ->Args({1, 2, 1})
+    ->Args({0, 2, 1})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  for (const char* r : {"1", "2"})
-    conform::bench::add_ratio(
-        std::string("BM_StepTornArm/membrane:1/res:") + r + "/min_time:2.000",
-        std::string("BM_StepTornArm/membrane:0/res:") + r + "/min_time:2.000",
-        std::string("membrane / Bullet links (today's default), torn arm, resolution ") + r);
+  for (const char* bench : {"BM_StepTornArm", "BM_TearArm"})
+    for (const char* r : {"1", "2"})
+      for (const char* t : {"1", "2"}) {
+        const std::string name = std::string(bench) + "/membrane:1/res:" + r + "/threads:" + t;
+        if (std::string(r) == "2" && std::string(t) == "2" && std::string(bench) == "BM_TearArm")
+          continue;
+        conform::bench::add_ratio(
+            name + "/min_time:2.000",
+            std::string(bench) + "/membrane:0/res:" + r + "/threads:1/min_time:2.000",
+            std::string("membrane (") + t + " thread" + (t[0] == '1' ? "" : "s") +
+                ") / Bullet links (the previous default), " +
+                (std::string(bench) == "BM_TearArm" ? "the stroke" : "torn arm") + ", resolution " +
+                r);
+      }
   for (const char* s : {"5", "0"}) {
     const std::string base = std::string("BM_StepUnskinned/") + s + "/min_time:1.000";
     conform::bench::add_ratio(std::string("BM_StepSkinned/") + s + "/min_time:1.000", base,

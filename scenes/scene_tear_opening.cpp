@@ -52,7 +52,7 @@ constexpr const char* kTearOpeningJson = R"json({
   },
   "geometric": { "amount": 0.01 },
   "profiles": { "snapshots": 6, "points": 41 },
-  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+  "physics": { "dt": 0.016666666666666666, "substeps": 1, "solver_iterations": 10,
                "gravity": [0, -9.81, 0] },
   "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
 })json";

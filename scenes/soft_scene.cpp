@@ -33,6 +33,7 @@ void read_skin(Reader& r, const bullet::Material& d, bullet::Material& m) {
       r.integer("max_newton_iterations", d.solver.max_newton_iterations, 1, 10000);
   m.solver.max_cg_iterations =
       r.integer("max_cg_iterations", d.solver.max_cg_iterations, 1, 1000000);
+  m.solver.threads = r.integer("solver_threads", d.solver.threads, 1, 256);
 }
 
 bullet::Material read_material(Reader& root, const bullet::Material& d) {

@@ -26,7 +26,7 @@ bullet::Material sheet_material(double sigma) {
   m.skin.prestress = {sigma, sigma};
   m.skin.attachment_stiffness = 0;  // a free membrane held by its pinned border
   m.skin.attachment_normal_stiffness = 0;
-  m.solver.tolerance = 1e-3 * std::max(sigma, 400.0);
+  m.solver.tolerance = 1e-5 * std::max(sigma, 400.0);  // soft sheet: see the check below
   m.solver.max_cg_iterations = 4000;
   return m;
 }
@@ -90,10 +90,12 @@ TEST(PluginMembrane, SlitOpensToTheMembranesEquilibriumInsideBullet) {
               r.core_w_max, 4 * 400 * 0.025 / 0.42e6, r.last.residual);
   EXPECT_TRUE(r.finite);
   EXPECT_TRUE(r.last.converged);
-  EXPECT_LE(r.last.residual, 0.4);
-  // Float Bullet: 0.002 % from the core's static equilibrium. Double-precision Bullet settles
-  // (the same value after 1 s and 3 s, residual 0.2 Pa) 2.8 % below it: not understood yet.
-  EXPECT_NEAR(r.w_max / r.core_w_max, 1.0, 0.03);
+  EXPECT_LE(r.last.residual, 4e-3);
+  // Bullet's damped run and the core's static Newton solve stop at different points inside
+  // the tolerance, and this sheet (0.8 m, no attachment) has soft modes: at 1e-3 sigma they
+  // differ by 2.8 %, at 1e-4 sigma by 0.9 %, at 1e-5 sigma by 0.08 % (first order in the
+  // tolerance, float and double Bullet alike).
+  EXPECT_NEAR(r.w_max / r.core_w_max, 1.0, 0.005);
   EXPECT_NEAR(r.w_max / (4 * 400 * 0.025 / 0.42e6), 1.0, 0.06);  // 5 mm elements: within 6 %
   EXPECT_LT(r.mass_error, 1e-9);
   EXPECT_LT(r.momentum_error, 1e-9);
