@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "piece_books.hpp"
@@ -13,8 +14,10 @@ namespace conform::bullet {
 // --- Pose sources ---
 
 void SkinDrive::set_pose(const skin::Pose& pose) {
-  if (pose.local.size() != global_.size())
-    throw std::invalid_argument("set_pose: wrong joint count");
+  if (pose.local.size() != skeleton_->joints.size())
+    throw std::invalid_argument("set_pose: the pose has " + std::to_string(pose.local.size()) +
+                                " joints, the skeleton " +
+                                std::to_string(skeleton_->joints.size()));
   source_ = [pose](double, skin::Pose& out) { out = pose; };
 }
 
@@ -36,13 +39,17 @@ void SkinDrive::set_pose_source(std::function<void(double, skin::Pose&)> source)
   source_ = std::move(source);
 }
 
+void SkinDrive::set_threads(int threads) {
+  threads_ = threads;
+  if (skinner_) skinner_->set_threads(threads);
+}
+
 // --- Skinned targets ---
 
 void SkinDrive::start(const mesh::SkinnedMesh& mesh) {
   pose_ = skin::Pose::rest(*skeleton_);
-  global_.resize(static_cast<std::size_t>(skeleton_->joint_count()));
-  versors_.resize(static_cast<std::size_t>(skeleton_->bone_count()));
-  kernels_.resize(versors_.size());
+  skinner_.emplace(*skeleton_, mesh.rest, skin::Influences<double>::from_mesh(mesh));
+  skinner_->set_threads(threads_);
   rebuild_inputs(mesh);
   skin(mesh, 0);
   previous_ = target_;
@@ -50,14 +57,8 @@ void SkinDrive::start(const mesh::SkinnedMesh& mesh) {
 
 void SkinDrive::rebuild_inputs(const mesh::SkinnedMesh& mesh) {
   const auto n = static_cast<std::size_t>(mesh.vertex_count());
-  rest_ = skin::SoaPoints<double>::from(mesh.rest);
-  bones_.resize(n * mesh::kMaxInfluences);
-  weights_.resize(n * mesh::kMaxInfluences);
-  for (std::size_t v = 0; v < n; ++v)
-    for (std::size_t k = 0; k < std::size_t(mesh::kMaxInfluences); ++k) {
-      bones_[k * n + v] = mesh.bones(Eigen::Index(k), Eigen::Index(v));
-      weights_[k * n + v] = mesh.weights(Eigen::Index(k), Eigen::Index(v));
-    }
+  if (skinner_->vertex_count() != n)
+    skinner_->set_points(mesh.rest, skin::Influences<double>::from_mesh(mesh));
   const std::size_t old = previous_.size();
   target_.resize(n);
   previous_.resize(n);
@@ -67,17 +68,9 @@ void SkinDrive::rebuild_inputs(const mesh::SkinnedMesh& mesh) {
 }
 
 void SkinDrive::skin(const mesh::SkinnedMesh& mesh, double time) {
-  if (rest_.size() != static_cast<std::size_t>(mesh.vertex_count())) rebuild_inputs(mesh);
+  if (target_.size() != static_cast<std::size_t>(mesh.vertex_count())) rebuild_inputs(mesh);
   if (source_) source_(time, pose_);
-  skin::global_versors(*skeleton_, pose_, global_);
-  skin::skinning_versors(*skeleton_, global_, versors_);
-  skin::versor_kernels<double>(versors_, kernels_);
-  skin::CgaSkinningJob<double> job;
-  job.kernels = kernels_;
-  job.input = {rest_.x, rest_.y, rest_.z, mesh::kMaxInfluences, bones_, weights_};
-  job.output = {target_.x, target_.y, target_.z};
-  job.threads = threads_;
-  job.run();
+  skinner_->skin(pose_, skin::SkinMode::cga, target_);
 }
 
 void SkinDrive::advance(const mesh::SkinnedMesh& mesh, double time) {

@@ -1,19 +1,22 @@
 // The skin drive's source side: the pose source gives a skeleton pose at the plugin's time, and
-// CGA skinning (eq 17) of the rest points gives every vertex its target; the previous substep's
-// targets are kept for target velocities. No Bullet here: Impl::update (skin_drive.cpp), the
+// CGA skinning (eq 17) of the rest points by core's skin::Skinner gives every vertex its target;
+// the previous substep's targets are kept for target velocities. The Skinner reads the mesh's
+// own influences as stored (Influences::from_mesh: no renormalization), so the targets are
+// those of the mesh's weights bit for bit. No Bullet here: Impl::update (skin_drive.cpp), the
 // one per-substep entry point, drives the nodes toward these targets.
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "conform/mesh/skinned_mesh.hpp"
 #include "conform/skin/animation.hpp"
 #include "conform/skin/pose.hpp"
 #include "conform/skin/skeleton.hpp"
-#include "conform/skin/skinning.hpp"
+#include "conform/skin/skinner.hpp"
 
 namespace conform::bullet {
 
@@ -27,12 +30,12 @@ class SkinDrive {
   void play(const skin::Animation& animation, skin::Blend blend, bool loop);
   void set_keyframes(skin::PoseTrack track, skin::Blend blend);
   void set_pose_source(std::function<void(double time, skin::Pose& pose)> source);
-  void set_threads(int threads) { threads_ = threads; }
+  void set_threads(int threads);
 
   /// The rest pose, the mesh's skinning inputs and its targets at time 0 (previous = target).
   void start(const mesh::SkinnedMesh& mesh);
-  /// Skins the rest points at `time` into the targets (re-reading the mesh's skinning inputs
-  /// once vertices were added).
+  /// Skins the rest points at `time` into the targets (re-reading the mesh's rest points and
+  /// influences once vertices were added).
   void skin(const mesh::SkinnedMesh& mesh, double time);
   /// A substep's start: the targets become the previous ones, then skin(time); a vertex added
   /// since gets its target as its previous one (zero target velocity).
@@ -54,12 +57,10 @@ class SkinDrive {
   const skin::Skeleton* skeleton_;
   std::function<void(double, skin::Pose&)> source_;
   skin::Pose pose_;
-  std::vector<skin::Versor> global_, versors_;
-  std::vector<skin::Kernel34<double>> kernels_;
-  // Skinning inputs/outputs, SoA (see skinning.hpp), rebuilt when vertices are added.
-  skin::SoaPoints<double> rest_, target_, previous_;
-  std::vector<std::int32_t> bones_;
-  std::vector<double> weights_;
+  std::optional<skin::Skinner<double>> skinner_;  // made by start(), on the validated mesh
+  // The skinned targets, SoA (see skinning.hpp): the Skinner writes into target_, and a
+  // substep's start swaps the two buffers.
+  skin::SoaPoints<double> target_, previous_;
   bool fill_previous_ = false;  // vertices were added: their previous targets are NaN
   int threads_ = 1;
 };

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -14,30 +15,49 @@ namespace conform::bullet {
 
 namespace {
 
-void validate(const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton,
-              const Material& material) {
+// Bad input throws naming it (ARCHITECTURE.md, Errors): the field, its value, the range.
+void require(bool ok, const char* field, double value, const char* range) {
+  if (ok) return;
+  std::ostringstream out;
+  out << "SkinnedSoftBody: material " << field << " = " << value << " is out of range (" << range
+      << ")";
+  throw std::invalid_argument(out.str());
+}
+
+void validate(const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton) {
   const std::int32_t n = mesh.vertex_count();
   if (n == 0) throw std::invalid_argument("SkinnedSoftBody: empty mesh");
   if (mesh.current.cols() != n || mesh.bones.cols() != n || mesh.weights.cols() != n)
-    throw std::invalid_argument(
-        "SkinnedSoftBody: current, bones and weights need one column per vertex");
+    throw std::invalid_argument("SkinnedSoftBody: " + std::to_string(n) + " rest points but " +
+                                std::to_string(mesh.current.cols()) + " current, " +
+                                std::to_string(mesh.bones.cols()) + " bone and " +
+                                std::to_string(mesh.weights.cols()) +
+                                " weight columns (need one per vertex)");
   if (skeleton.bone_count() == 0) throw std::invalid_argument("SkinnedSoftBody: no bones");
-  for (const auto& f : mesh.faces)
-    for (const auto v : f)
-      if (v < 0 || v >= n) throw std::invalid_argument("SkinnedSoftBody: face index out of range");
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+    for (const auto v : mesh.faces[f])
+      if (v < 0 || v >= n)
+        throw std::invalid_argument("SkinnedSoftBody: face " + std::to_string(f) + " has vertex " +
+                                    std::to_string(v) + ", out of range [0, " + std::to_string(n) +
+                                    ")");
   for (std::int32_t v = 0; v < n; ++v)
     for (int k = 0; k < mesh::kMaxInfluences; ++k)
       if (mesh.weights(k, v) != 0 &&
           (mesh.bones(k, v) < 0 || mesh.bones(k, v) >= skeleton.bone_count()))
-        throw std::invalid_argument("SkinnedSoftBody: bone id out of range at vertex " +
-                                    std::to_string(v));
-  if (!(material.pretension >= 0 && material.pretension < 1))
-    throw std::invalid_argument("SkinnedSoftBody: pretension must be in [0, 1)");
-  if (!(material.density > 0)) throw std::invalid_argument("SkinnedSoftBody: density must be > 0");
-  if (!(material.link_stiffness > 0 && material.link_stiffness <= 1))
-    throw std::invalid_argument("SkinnedSoftBody: link_stiffness must be in (0, 1]");
-  if (!(material.bending_stiffness >= 0 && material.bending_stiffness <= 1))
-    throw std::invalid_argument("SkinnedSoftBody: bending_stiffness must be in [0, 1]");
+        throw std::invalid_argument("SkinnedSoftBody: vertex " + std::to_string(v) +
+                                    " has bone id " + std::to_string(mesh.bones(k, v)) +
+                                    ", out of range [0, " + std::to_string(skeleton.bone_count()) +
+                                    ")");
+}
+
+void validate(const Material& material) {
+  require(material.pretension >= 0 && material.pretension < 1, "pretension", material.pretension,
+          "[0, 1)");
+  require(material.density > 0, "density", material.density, "> 0");
+  require(material.link_stiffness > 0 && material.link_stiffness <= 1, "link_stiffness",
+          material.link_stiffness, "(0, 1]");
+  require(material.bending_stiffness >= 0 && material.bending_stiffness <= 1, "bending_stiffness",
+          material.bending_stiffness, "[0, 1]");
   if (material.model == MaterialModel::membrane) {
     material.skin.validate();  // throws naming the field and its value
     material.solver.validate();
@@ -76,7 +96,8 @@ SkinnedSoftBody::Impl::Impl(btSoftBodyWorldInfo& info, std::function<void(btSoft
       skeleton_(skeleton),
       material_(material),
       drive_(skeleton_) {
-  validate(mesh_, skeleton_, material_);
+  validate(mesh_, skeleton_);
+  validate(material_);
   if (membrane_model()) material_.density = material_.skin.areal_density;  // the books' masses
   adjacency_.build(mesh_);
   face_index_.build(mesh_);

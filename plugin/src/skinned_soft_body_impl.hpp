@@ -160,6 +160,7 @@ struct SkinnedSoftBody::Impl {
   void make_new_vertices(MirrorContext& c);
   void remove_faces(MirrorContext& c);
   void assign_face_slots(MirrorContext& c);
+  void move_face_slot(std::int32_t last, std::int32_t slot);  // step 3's swap-with-last
   void find_pieces(MirrorContext& c);
   void move_pieces(MirrorContext& c);
   void move_into_body(MirrorContext& c, std::span<const std::int32_t> moving, std::int32_t into);
@@ -188,7 +189,16 @@ struct SkinnedSoftBody::Impl {
   std::vector<double> mass_;
   std::vector<std::uint8_t> kinematic_, pinned_;
   std::vector<std::vector<std::int32_t>> vertex_faces_;  // incident mesh faces
-  // Per mesh face: the shadow copy of the faces Bullet mirrors, and where each lives.
+  // Per mesh face: the faces as of the change being mirrored, and where each lives in Bullet.
+  // faces_ is a second copy of mesh_.faces on purpose, equal to it between edits. mesh::drill
+  // and Tear::advance apply several changes to mesh_ in one call (each computed on the mesh the
+  // previous one left), and the mirror replays them one by one afterwards. While change i is
+  // mirrored, mesh_ already holds the faces after the last change. The mirror also needs the
+  // vertices of each removed face, which mesh::apply has overwritten or popped by then.
+  // faces_ follows every change by the same slot rule (mesh::visit_face_slots), so a face
+  // index means the same face in both once the last change is mirrored
+  // (tests: expect_mirrors_mesh). Bullet's own face order is per body (face_piece_,
+  // face_slot_; Piece::face_id maps back), not this array.
   std::vector<mesh::Face> faces_;
   std::vector<std::int32_t> face_piece_, face_slot_;
   // Per undirected edge (min, max): faces using it, and its link index in its piece.

@@ -135,42 +135,30 @@ void SkinnedSoftBody::Impl::remove_faces(MirrorContext& c) {
 }
 
 void SkinnedSoftBody::Impl::assign_face_slots(MirrorContext& c) {
-  // 3. The face slots, exactly as mesh::apply does them (topology_change.hpp): the first added
-  // faces take the removed faces' slots, the rest are appended, and the slots of removed faces
-  // left over are filled from the end, highest first.
-  const auto& removed = c.change.removed_faces;
-  const auto& added = c.change.added_faces;
-  const std::size_t nr = removed.size(), na = added.size(), nk = std::min(nr, na);
-  for (std::size_t i = 0; i < nk; ++i) {
-    faces_[static_cast<std::size_t>(removed[i])] = added[i];
-    c.pending.push_back(removed[i]);
-  }
-  for (std::size_t i = nk; i < na; ++i) {
-    faces_.push_back(added[i]);
-    face_piece_.push_back(-1);
-    face_slot_.push_back(-1);
-    c.pending.push_back(std::int32_t(faces_.size()) - 1);
-  }
-  for (std::size_t i = nr; i-- > nk;) {
-    const std::int32_t slot = removed[i];
-    const std::int32_t last = std::int32_t(faces_.size()) - 1;
-    if (slot != last) {
-      const auto s = static_cast<std::size_t>(slot), l = static_cast<std::size_t>(last);
-      faces_[s] = faces_[l];
-      face_piece_[s] = face_piece_[l];
-      face_slot_[s] = face_slot_[l];
-      if (face_piece_[s] >= 0)
-        pieces_[static_cast<std::size_t>(face_piece_[s])]
-            ->face_id[static_cast<std::size_t>(face_slot_[s])] = slot;
-      for (const auto v : faces_[s]) {
-        auto& list = vertex_faces_[static_cast<std::size_t>(v)];
-        std::replace(list.begin(), list.end(), last, slot);
-      }
+  // 3. The face slots by the mesh's rule (mesh::visit_face_slots, as mesh::apply does them):
+  // added faces overwrite removed slots, then are appended; leftover removed slots are filled
+  // by swap-with-last, which also moves the face's Bullet slot and its vertices' face lists.
+  struct Slots {
+    Impl& impl;
+    MirrorContext& c;
+    void fill(std::int32_t slot, std::size_t k) {
+      impl.faces_[static_cast<std::size_t>(slot)] = c.change.added_faces[k];
+      c.pending.push_back(slot);
     }
-    faces_.pop_back();
-    face_piece_.pop_back();
-    face_slot_.pop_back();
-  }
+    void append(std::int32_t slot, std::size_t k) {
+      impl.faces_.push_back(c.change.added_faces[k]);
+      impl.face_piece_.push_back(-1);
+      impl.face_slot_.push_back(-1);
+      c.pending.push_back(slot);
+    }
+    void move(std::int32_t last, std::int32_t slot) { impl.move_face_slot(last, slot); }
+    void pop(std::int32_t) {
+      impl.faces_.pop_back();
+      impl.face_piece_.pop_back();
+      impl.face_slot_.pop_back();
+    }
+  };
+  mesh::visit_face_slots(c.change, Slots{*this, c});
   // The added faces' vertices and the new vertices seed the split search too.
   c.new_edges.assign(c.pending.size(), 0);
   for (std::size_t i = 0; i < c.pending.size(); ++i) {
@@ -185,6 +173,20 @@ void SkinnedSoftBody::Impl::assign_face_slots(MirrorContext& c) {
   stats_.added_faces += std::int32_t(c.pending.size());
   stats_.new_nodes += c.added;
   for (std::int32_t i = 0; i < c.added; ++i) split_.seed(c.v0 + i);
+}
+
+void SkinnedSoftBody::Impl::move_face_slot(std::int32_t last, std::int32_t slot) {
+  const auto s = static_cast<std::size_t>(slot), l = static_cast<std::size_t>(last);
+  faces_[s] = faces_[l];
+  face_piece_[s] = face_piece_[l];
+  face_slot_[s] = face_slot_[l];
+  if (face_piece_[s] >= 0)
+    pieces_[static_cast<std::size_t>(face_piece_[s])]
+        ->face_id[static_cast<std::size_t>(face_slot_[s])] = slot;
+  for (const auto v : faces_[s]) {
+    auto& list = vertex_faces_[static_cast<std::size_t>(v)];
+    std::replace(list.begin(), list.end(), last, slot);
+  }
 }
 
 void SkinnedSoftBody::Impl::find_pieces(MirrorContext& c) {

@@ -1,6 +1,7 @@
 #include "conform/skin/skinner.hpp"
 
 #include <stdexcept>
+#include <utility>
 
 namespace conform::skin {
 
@@ -29,21 +30,38 @@ const char* skin_mode_name(SkinMode mode) {
 template <class T>
 Skinner<T>::Skinner(const Skeleton& skeleton, Eigen::Ref<const Eigen::Matrix3Xd> rest,
                     const InfluenceLists& influences, int max_influences)
+    : Skinner(skeleton, rest, Influences<T>::select(influences, max_influences)) {}
+
+template <class T>
+Skinner<T>::Skinner(const Skeleton& skeleton, Eigen::Ref<const Eigen::Matrix3Xd> rest,
+                    Influences<T> influences)
     : skeleton_(&skeleton),
-      rest_(SoaPoints<T>::from(rest)),
-      influences_(Influences<T>::select(influences, max_influences)),
       global_(skeleton.joints.size()),
       skin_versors_(skeleton.bones.size()),
       kernels_(skeleton.bones.size()),
       coefficients_(skeleton.bones.size()),
       dq_(skeleton.bones.size()),
       matrices_(skeleton) {
-  if (influences.vertex_count() != rest.cols())
+  if (influences.vertex_count != rest.cols())
     throw std::invalid_argument("Skinner: influences and positions differ in vertex count");
   if (const auto e = skeleton.validate(); !e.empty()) throw std::invalid_argument("Skinner: " + e);
-  out_.resize(rest_.size());
-  if (const auto e = validate_skin_io(input(), output_span(), skeleton.bones.size()); !e.empty())
+  set_points(rest, std::move(influences));
+}
+
+template <class T>
+void Skinner<T>::set_points(Eigen::Ref<const Eigen::Matrix3Xd> rest, Influences<T> influences) {
+  if (influences.vertex_count != rest.cols())
+    throw std::invalid_argument("Skinner: influences and positions differ in vertex count");
+  SoaPoints<T> points = SoaPoints<T>::from(rest), out;
+  out.resize(points.size());
+  const SkinInput<T> in{points.x,         points.y,         points.z,
+                        influences.count, influences.bones, influences.weights};
+  if (const auto e = validate_skin_io(in, {out.x, out.y, out.z}, skeleton_->bones.size());
+      !e.empty())
     throw std::invalid_argument("Skinner: " + e);
+  rest_ = std::move(points);
+  out_ = std::move(out);
+  influences_ = std::move(influences);
 }
 
 template <class T>
@@ -76,18 +94,23 @@ void Skinner<T>::prepare(const Pose& pose, SkinMode mode) {
 
 template <class T>
 void Skinner<T>::run(SkinMode mode) {
+  run(mode, output_span());
+}
+
+template <class T>
+void Skinner<T>::run(SkinMode mode, SkinOutput<T> out) {
   switch (mode) {
     case SkinMode::cga:
-      CgaSkinningJob<T>{kernels_, input(), output_span(), threads_}.run();
+      CgaSkinningJob<T>{kernels_, input(), out, threads_}.run();
       break;
     case SkinMode::versor:
-      VersorBlendJob<T>{coefficients_, input(), output_span(), threads_}.run();
+      VersorBlendJob<T>{coefficients_, input(), out, threads_}.run();
       break;
     case SkinMode::matrix_lbs:
-      LbsSkinningJob<T>{kernels_, input(), output_span(), threads_}.run();
+      LbsSkinningJob<T>{kernels_, input(), out, threads_}.run();
       break;
     case SkinMode::dual_quaternion:
-      DqSkinningJob<T>{dq_, input(), output_span(), threads_}.run();
+      DqSkinningJob<T>{dq_, input(), out, threads_}.run();
       break;
   }
 }
@@ -96,6 +119,13 @@ template <class T>
 void Skinner<T>::skin(const Pose& pose, SkinMode mode) {
   prepare(pose, mode);
   run(mode);
+}
+
+template <class T>
+void Skinner<T>::skin(const Pose& pose, SkinMode mode, SoaPoints<T>& out) {
+  prepare(pose, mode);
+  out.resize(rest_.size());
+  run(mode, {out.x, out.y, out.z});
 }
 
 template class Skinner<float>;

@@ -95,6 +95,22 @@ Influences<T> Influences<T>::select(const InfluenceLists& lists, int k) {
 }
 
 template <class T>
+Influences<T> Influences<T>::from_mesh(const mesh::SkinnedMesh& mesh) {
+  Influences r;
+  r.vertex_count = mesh.vertex_count();
+  r.count = mesh::kMaxInfluences;
+  const auto n = static_cast<std::size_t>(r.vertex_count);
+  r.bones.resize(n * mesh::kMaxInfluences);
+  r.weights.resize(n * mesh::kMaxInfluences);
+  for (std::size_t v = 0; v < n; ++v)
+    for (std::size_t k = 0; k < std::size_t(mesh::kMaxInfluences); ++k) {
+      r.bones[k * n + v] = mesh.bones(Eigen::Index(k), Eigen::Index(v));
+      r.weights[k * n + v] = static_cast<T>(mesh.weights(Eigen::Index(k), Eigen::Index(v)));
+    }
+  return r;
+}
+
+template <class T>
 SoaPoints<T> SoaPoints<T>::from(Eigen::Ref<const Eigen::Matrix3Xd> p) {
   SoaPoints s;
   s.resize(static_cast<std::size_t>(p.cols()));

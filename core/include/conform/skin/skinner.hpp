@@ -30,9 +30,21 @@ class Skinner {
   /// influences, renormalized. Throws std::invalid_argument on inconsistent sizes or bone ids.
   Skinner(const Skeleton& skeleton, Eigen::Ref<const Eigen::Matrix3Xd> rest,
           const InfluenceLists& influences, int max_influences = mesh::kMaxInfluences);
+  /// The same with influences already in the jobs' layout, used as they are (e.g.
+  /// Influences::from_mesh, a mesh's own weights without renormalization).
+  Skinner(const Skeleton& skeleton, Eigen::Ref<const Eigen::Matrix3Xd> rest,
+          Influences<T> influences);
+
+  /// New rest points and influences for the same skeleton (a mesh that gained vertices); the
+  /// per-bone buffers stay. Throws std::invalid_argument, changing nothing, on inconsistent
+  /// sizes or bone ids.
+  void set_points(Eigen::Ref<const Eigen::Matrix3Xd> rest, Influences<T> influences);
 
   /// Poses the mesh: per-bone coefficients for `mode` from `pose`, then the vertex loop.
   void skin(const Pose& pose, SkinMode mode);
+  /// The same into `out` (resized to vertex_count()) instead of output(): a caller that keeps
+  /// the previous frame swaps two buffers instead of copying one.
+  void skin(const Pose& pose, SkinMode mode, SoaPoints<T>& out);
   /// Per-bone step only (what skin() does before the vertex loop).
   void prepare(const Pose& pose, SkinMode mode);
   /// Vertex loop only, with the coefficients of the last prepare().
@@ -52,6 +64,7 @@ class Skinner {
  private:
   SkinInput<T> input() const;
   SkinOutput<T> output_span();
+  void run(SkinMode mode, SkinOutput<T> out);
 
   const Skeleton* skeleton_;
   SoaPoints<T> rest_, out_;

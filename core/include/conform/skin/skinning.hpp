@@ -8,6 +8,14 @@
 //   out x, y, z       #V each      posed positions
 // Because weights are sorted, a vertex's loop stops at its first zero weight.
 //
+// Bone influences have three representations, each where it is needed:
+//   mesh::SkinnedMesh::bones/weights  4 per vertex, one column each: what apply() blends into
+//                                     a new vertex (§4.3) and a cut, tear or drill carries;
+//   InfluenceLists                    any number per vertex, as imported: the source from
+//                                     which a Skinner's K largest are chosen;
+//   Influences<T>                     the jobs' K-slot SoA layout, made by select() (from
+//                                     lists, renormalized) or from_mesh() (a mesh's as stored).
+//
 // Modes:
 //   CgaSkinningJob     eq 17 with per-term down-projection (§4.3): each term
 //                      down(V_n c V_n⁻¹) = d_n R_n x + t_n is a 3×4 kernel (A_n = d_n R_n,
@@ -57,6 +65,10 @@ struct Influences {
   /// Each vertex's `k` largest influences, renormalized to sum 1 (a vertex with no influence
   /// gets bone 0 at weight 1). Ties keep the imported order.
   static Influences select(const InfluenceLists& lists, int k = mesh::kMaxInfluences);
+  /// The mesh's kMaxInfluences slots exactly as stored (the mesh keeps them sorted and summing
+  /// to 1, skinned_mesh.hpp): no selection and no renormalization, so skinning them gives the
+  /// same bits as the mesh's own weights.
+  static Influences from_mesh(const mesh::SkinnedMesh& mesh);
 };
 
 template <class T>
