@@ -1,21 +1,10 @@
 #include "conform/membrane/skin_material.hpp"
 
 #include <cmath>
-#include <sstream>
-#include <stdexcept>
-#include <string>
+
+#include "range_error.hpp"
 
 namespace conform::membrane {
-namespace {
-
-void require(bool ok, const char* field, double value, const char* range) {
-  if (ok) return;
-  std::ostringstream out;
-  out << "skin material: " << field << " = " << value << " is out of range (" << range << ")";
-  throw std::invalid_argument(out.str());
-}
-
-}  // namespace
 
 double SkinMaterial::lame_lambda() const {
   return youngs_modulus * poisson_ratio / (1 - poisson_ratio * poisson_ratio);
@@ -27,6 +16,7 @@ double SkinMaterial::lame_mu() const {
 
 void SkinMaterial::validate() const {
   const auto finite = [](double v) { return std::isfinite(v); };
+  const RangeCheck require("skin material");
   require(finite(youngs_modulus) && youngs_modulus > 0, "youngs_modulus", youngs_modulus, "> 0 Pa");
   require(finite(poisson_ratio) && poisson_ratio >= 0 && poisson_ratio < 0.5, "poisson_ratio",
           poisson_ratio, "[0, 0.5)");

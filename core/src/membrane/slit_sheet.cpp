@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+
 #include <stdexcept>
+#include "range_error.hpp"
 
 namespace conform::membrane {
 namespace {
@@ -47,23 +49,18 @@ std::vector<double> mirrored(const std::vector<double>& positive) {
 }  // namespace
 
 void SlitSheetOptions::validate() const {
-  const auto fail = [](const char* field, double value, const char* range) {
-    std::ostringstream out;
-    out << "slit sheet: " << field << " = " << value << " is out of range (" << range << ")";
-    throw std::invalid_argument(out.str());
-  };
-  if (!(slit_length > 0) || !std::isfinite(slit_length)) fail("slit.length", slit_length, "> 0 m");
-  if (!(width >= 8 * slit_length) || !std::isfinite(width))
-    fail("sheet.width", width, ">= 8 x slit.length");
-  if (!(element_size > 0 && element_size <= 0.25 * slit_length))
-    fail("sheet.resolution", element_size, "(0, slit.length / 4] m");
-  if (!(fine_zone >= 0) || !std::isfinite(fine_zone)) fail("fine_zone", fine_zone, ">= 0");
-  if (!(grading >= 1 && grading <= 2)) fail("grading", grading, "[1, 2]");
-  if (!(tip_refinement >= 1 && tip_refinement <= 64))
-    fail("tip_refinement", tip_refinement, "[1, 64]");
-  if (!(tip_grading > 1 && tip_grading <= 2)) fail("tip_grading", tip_grading, "(1, 2]");
-  if (!std::isfinite(slit_angle)) fail("slit.angle", slit_angle, "finite");
-  if (2 * width / element_size > 2e4) fail("sheet.resolution", element_size, "too fine");
+  const RangeCheck check("slit sheet");
+  check(slit_length > 0 && std::isfinite(slit_length), "slit.length", slit_length, "> 0 m");
+  check(width >= 8 * slit_length && std::isfinite(width), "sheet.width", width,
+        ">= 8 x slit.length");
+  check(element_size > 0 && element_size <= 0.25 * slit_length, "sheet.resolution", element_size,
+        "(0, slit.length / 4] m");
+  check(fine_zone >= 0 && std::isfinite(fine_zone), "fine_zone", fine_zone, ">= 0");
+  check(grading >= 1 && grading <= 2, "grading", grading, "[1, 2]");
+  check(tip_refinement >= 1 && tip_refinement <= 64, "tip_refinement", tip_refinement, "[1, 64]");
+  check(tip_grading > 1 && tip_grading <= 2, "tip_grading", tip_grading, "(1, 2]");
+  check(std::isfinite(slit_angle), "slit.angle", slit_angle, "finite");
+  check(2 * width / element_size <= 2e4, "sheet.resolution", element_size, "too fine");
 }
 
 SlitSheet make_slit_sheet(const SlitSheetOptions& o) {

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+
 #include <stdexcept>
+#include "range_error.hpp"
 
 namespace conform::membrane {
 namespace {
@@ -23,20 +25,15 @@ void require_cols(const Eigen::Ref<const Eigen::Matrix3Xd>& m, Eigen::Index cols
 }  // namespace
 
 void SolverSettings::validate() const {
-  const auto fail = [](const char* field, double value, const char* range) {
-    std::ostringstream out;
-    out << "membrane solver: " << field << " = " << value << " is out of range (" << range << ")";
-    throw std::invalid_argument(out.str());
-  };
-  if (!(tolerance > 0) || !std::isfinite(tolerance)) fail("tolerance", tolerance, "> 0 Pa");
-  if (max_newton_iterations < 1) fail("max_newton_iterations", max_newton_iterations, ">= 1");
-  if (max_cg_iterations < 1) fail("max_cg_iterations", max_cg_iterations, ">= 1");
-  if (threads < 1) fail("threads", threads, ">= 1");
-  if (!(cg_relative_tolerance > 0 && cg_relative_tolerance < 1))
-    fail("cg_relative_tolerance", cg_relative_tolerance, "(0, 1)");
-  if (!(local_fraction >= 0 && local_fraction < 1))
-    fail("local_fraction", local_fraction, "[0, 1)");
-  if (!(local_reach > 0) || !std::isfinite(local_reach)) fail("local_reach", local_reach, "> 0");
+  const RangeCheck check("membrane solver");
+  check(tolerance > 0 && std::isfinite(tolerance), "tolerance", tolerance, "> 0 Pa");
+  check(max_newton_iterations >= 1, "max_newton_iterations", max_newton_iterations, ">= 1");
+  check(max_cg_iterations >= 1, "max_cg_iterations", max_cg_iterations, ">= 1");
+  check(threads >= 1, "threads", threads, ">= 1");
+  check(cg_relative_tolerance > 0 && cg_relative_tolerance < 1, "cg_relative_tolerance",
+        cg_relative_tolerance, "(0, 1)");
+  check(local_fraction >= 0 && local_fraction < 1, "local_fraction", local_fraction, "[0, 1)");
+  check(local_reach > 0 && std::isfinite(local_reach), "local_reach", local_reach, "> 0");
 }
 
 struct Solver::Scratch {
