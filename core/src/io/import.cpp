@@ -45,6 +45,8 @@ struct JointFrame {
   bool odd = false;
   Versor global_versor;
   bool exact_chain = true;
+  bool exact = true;  // its own versor
+  bool used = false;  // a bone's joint or one of their ancestors: it moves vertices
 };
 
 // Vertices whose weights do not sum to 1, over the whole model (one summary warning).
@@ -70,12 +72,27 @@ struct Builder {
   [[noreturn]] void fail(const std::string& problem) const { throw ImportError(file, problem); }
   void warn(const std::string& w) { model.warnings.push_back(w); }
 
+  // The nearest versor; an approximation is recorded, or returned in `exact` when given.
   Versor to_versor(const Eigen::Matrix4d& m, const std::string& what, bool* exact = nullptr) {
     const auto d = detail::nearest_versor(m);
     if (!d) fail(what + " has a NaN, singular or projective transform");
-    if (!d->exact) approximated.push_back(what);
-    if (exact) *exact = d->exact;
+    if (exact)
+      *exact = d->exact;
+    else if (!d->exact)
+      approximated.push_back(what);
     return d->versor;
+  }
+
+  // Marks `joint` and its ancestors as moving vertices; their approximated versors count.
+  void use(std::int32_t joint) {
+    for (auto j = joint; j >= 0; j = model.skeleton.joints[static_cast<std::size_t>(j)].parent) {
+      JointFrame& f = frames[static_cast<std::size_t>(j)];
+      if (f.used) return;
+      f.used = true;
+      if (!f.exact)
+        approximated.push_back("node '" + model.skeleton.joints[static_cast<std::size_t>(j)].name +
+                               "'");
+    }
   }
 
   // Every node becomes a joint. A mirroring node makes its subtree odd: its versor is the
@@ -100,12 +117,13 @@ struct Builder {
     skin::Joint j;
     j.name = node_name(node);
     j.parent = parent;
-    j.rest = to_versor(detail::reflected(local, parent_odd, f.odd), "node '" + j.name + "'",
-                       &f.exact_chain);
+    j.rest =
+        to_versor(detail::reflected(local, parent_odd, f.odd), "node '" + j.name + "'", &f.exact);
+    f.exact_chain = f.exact;
     if (parent >= 0) {
       const JointFrame& p = frames[static_cast<std::size_t>(parent)];
       f.global_versor = p.global_versor * j.rest;
-      f.exact_chain = f.exact_chain && p.exact_chain;
+      f.exact_chain = f.exact && p.exact_chain;
     } else {
       f.global_versor = j.rest;
     }
@@ -153,7 +171,9 @@ struct Builder {
     j.name = name;
     j.rest = *inv;
     model.skeleton.joints.push_back(j);
-    frames.push_back({nullptr, Eigen::Matrix4d::Identity(), false, *inv, true});
+    JointFrame f;
+    f.global_versor = *inv;
+    frames.push_back(f);
     warn("bone '" + name + "' of mesh '" + mesh_name +
          "' has no node of that name; it stays at its bind pose");
     return joint_by_name.emplace(name, model.skeleton.joint_count() - 1).first->second;
@@ -177,6 +197,7 @@ struct Builder {
     for (std::size_t i = 0; i < model.skeleton.bones.size(); ++i)
       if (model.skeleton.bones[i].joint == joint && bone_keys[i] == key)
         return static_cast<std::int32_t>(i);
+    use(joint);
     const JointFrame& f = frames[static_cast<std::size_t>(joint)];
     const std::string what = "bind transform of bone '" + name + "'";
     skin::Bone b;
@@ -456,7 +477,7 @@ struct Builder {
         inexact = true;
       ch.scale.push_back({key.mTime, s.allFinite() ? positive.cwiseAbs().mean() : s.mean()});
     }
-    if (inexact) approximated.push_back(what);
+    if (inexact && f.used) approximated.push_back(what);
     return ch;
   }
 

@@ -10,18 +10,20 @@
 //   root joint of its own at its bind pose (O⁻¹), with a warning. A mesh placed by several
 //   nodes is imported once per node (MeshInfo::source names the file's mesh).
 // - Exact bind transforms: matrix skinning is x' = Σ w G_b O_b x (G_b the bone node's global
-//   matrix, O_b its offset). Each instance's rest positions are baked, x_rest = K x, with K
-//   the mesh node's global transform (normals by K⁻ᵀ; faces rewound when K mirrors), so that
-//   every bone's rest skinning matrix G_b O_b K⁻¹ is a similarity even when the mesh node is
-//   scaled non-uniformly or mirrored; a file whose offsets ignore the mesh node bakes the
-//   transform its first bone's offset implies (G_b O_b) instead. Each bone's offset versor is
-//   B_b = G̃_b⁻¹ · (G_b O_b K⁻¹), G̃_b its joint's global versor at rest, so the rest pose is
-//   exact. A mirroring node makes its subtree odd: the joints store F^parent L F^self with
-//   F = diag(1, 1, −1) (keys alike), which is proper, and the mirrors cancel in G_b O_b.
-//   What stays inexact is a non-uniform scale that an animation really moves (animated, or
-//   above an animated bone) or a key that changes a node's parity: the nearest similarity is
-//   used, and the importer measures the result against matrix skinning of the file at the rest
-//   pose and every key time and warns with the largest deviation relative to the diagonal.
+//   matrix, O_b its offset). A mesh's bind transform K is its node's global transform, or,
+//   when the file's offsets ignore that node (X/test_cube_*.x), the one its first bone's
+//   offset implies (G_b O_b); with it every bone's rest skinning matrix G_b O_b K⁻¹ is a
+//   proper similarity. K = Q N, Q the nearest proper similarity, which the versors carry; N,
+//   the non-uniform stretch or mirror, is baked into the rest positions, x_rest = N x
+//   (normals by N⁻ᵀ, faces rewound when N mirrors; nothing is baked when K is a similarity).
+//   A mirroring node makes its subtree odd: its joints store F^parent L F^self with
+//   F = diag(1, 1, −1) (animation keys alike), which is proper, and the mirrors cancel in
+//   G_b O_b. A bone below an approximated node gets B_b = G̃_b⁻¹ · (G_b O_b N⁻¹), G̃_b its
+//   joint's global versor at rest, so the rest pose stays exact. What cannot be exact is a
+//   non-uniform scale that an animation really moves (animated, or above an animated bone)
+//   or a key that changes a node's parity: the nearest similarity is used, and the importer
+//   measures the result against matrix skinning of the file at the rest pose and every key
+//   time and warns with the largest deviation relative to the model's diagonal.
 // - Influences: all kept (SkinnedModel::influences). Each vertex's weights are normalized to
 //   sum 1; sums off by more than 1e-4 (exports that truncate influences, Blender's 0.94–1.38)
 //   give one summary warning, or with ImportOptions::strict_weights an error. A vertex whose

@@ -4,10 +4,12 @@
 // vertices first, then mesh 1's, ...; within a mesh, assimp's vertex order after
 // triangulation and joining identical vertices). A mesh that several nodes place is merged
 // once per node (its instances, in node order). `meshes` records each instance's vertex and
-// face range. Positions in `rest` are baked: each instance's file positions times its bind
-// transform K (the mesh node's global transform, see import.hpp), i.e. the bind pose in world
-// space; the bones' offsets (B_n) start from there. `current` holds the skinned rest pose
-// (every node at its own transform) in world space.
+// face range. Positions in `rest` are in each mesh's own space, which is the space its bones'
+// offsets (B_n) start from, with the part of the mesh's bind transform that no versor
+// represents (a non-uniform stretch, a mirror) baked in (see import.hpp; nothing is baked for
+// a mesh whose bind transform is a similarity). Skinning maps them to world space, the space
+// assimp's node hierarchy places the meshes in. `current` holds the skinned rest pose (every
+// node at its own transform) in that world space.
 #pragma once
 
 #include <cstdint>
