@@ -47,10 +47,9 @@ Setup* setup(int which) {
     s->pose.apply_local(1, skin::Versor::from_motor(M::from_axis_angle({1, 0, 0}, 1.4)));
     s->pose.apply_local(2, skin::Versor{M::from_axis_angle({0, 0.2, 1}, 1.0), 1.2});
   } else {
-    io::ImportOptions o;
-    o.weight_tolerance = 0.5;  // the file's weights sum to 0.94–1.38
-    s->model = io::import_model(
-        std::string(CONFORM_ASSIMP_MODELS) + "/FBX/animation_with_skeleton.fbx", o);
+    // The file's weights sum to 0.94–1.38: normalized on import.
+    s->model =
+        io::import_model(std::string(CONFORM_ASSIMP_MODELS) + "/FBX/animation_with_skeleton.fbx");
     const auto& a = s->model.animations.at(0);
     a.sample(s->model.skeleton, 0.5 * a.duration(), skin::Blend::log, s->pose);
   }

@@ -57,8 +57,7 @@ void register_info(CLI::App& app, Context& context) {
   auto options = std::make_shared<io::ImportOptions>();
   options->crash_guard = true;  // a corrupt file must not kill the command
   cmd->add_option("MODEL", *model, "model file (any format assimp reads) or arm[:N]");
-  cmd->add_option("--weight-tolerance", options->weight_tolerance,
-                  "largest |sum of a vertex's weights - 1| accepted (renormalized; default 0.1)");
+  add_strict_weights(cmd, options->strict_weights);
   cmd->callback([&context, model, options]() {
     if (model->empty()) {
       std::cout << "conform " << conform::version() << "\n"

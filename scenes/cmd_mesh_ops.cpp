@@ -34,6 +34,7 @@ struct Common {
   std::string model;
   std::string out;
   std::string format = "ply";
+  bool strict_weights = false;
 };
 
 void add_common(CLI::App* cmd, Common& c) {
@@ -41,13 +42,19 @@ void add_common(CLI::App* cmd, Common& c) {
   cmd->add_option("--out", c.out, "output directory (created if missing)")->required();
   cmd->add_option("--format", c.format, "ply (binary), ply-ascii or obj")
       ->check(CLI::IsMember({"ply", "ply-ascii", "obj"}));
+  add_strict_weights(cmd, c.strict_weights);
 }
 
 // Loads the model; returns its mesh (current = the bind pose in world space).
 mesh::SkinnedMesh load(const Common& c, nlohmann::json& summary) {
   const auto t0 = Clock::now();
-  io::SkinnedModel model = io::load_model(c.model);
+  io::ImportOptions options;
+  options.strict_weights = c.strict_weights;
+  io::SkinnedModel model = io::load_model(c.model, options);
+  for (const auto& w : model.warnings)
+    std::cerr << "warning: " << model.source << ": " << w << "\n";
   summary["model"] = model.source;
+  summary["warnings"] = model.warnings;
   summary["input"] = {{"vertices", model.mesh.vertex_count()}, {"faces", model.mesh.face_count()}};
   summary["timing_ms"]["load"] = ms_since(t0);
   return std::move(model.mesh);

@@ -21,7 +21,7 @@ struct SkinArgs {
   int frames = 0;
   int max_influences = 4;
   int threads = 0;
-  double weight_tolerance = 0.1;
+  bool strict_weights = false;
 };
 
 using Clock = std::chrono::steady_clock;
@@ -64,7 +64,7 @@ int run_skin(const SkinArgs& a, bool has_time, bool has_frames) {
 
   auto t0 = Clock::now();
   io::ImportOptions import_options;
-  import_options.weight_tolerance = a.weight_tolerance;
+  import_options.strict_weights = a.strict_weights;
   import_options.crash_guard = true;  // a corrupt file must not kill the command
   io::SkinnedModel model = io::load_model(a.model, import_options);
   const double load_ms = ms_since(t0);
@@ -143,8 +143,7 @@ void register_skin(CLI::App& app, Context& context) {
   cmd->add_option("--max-influences", args->max_influences,
                   "largest influences used per vertex (default 4)");
   cmd->add_option("--threads", args->threads, "OpenMP threads (default: all)");
-  cmd->add_option("--weight-tolerance", args->weight_tolerance,
-                  "largest |sum of a vertex's weights - 1| accepted (renormalized; default 0.1)");
+  add_strict_weights(cmd, args->strict_weights);
   cmd->add_option("--out", args->out, "output .ply or .obj (with --frames: name_0000.ext, ...)")
       ->required();
   cmd->callback([&context, args, time, frames]() {

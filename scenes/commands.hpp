@@ -20,6 +20,14 @@ void register_mesh_ops(CLI::App& app, Context& context);  // cmd_mesh_ops.cpp (i
 void register_run(CLI::App& app, Context& context);       // cmd_run.cpp    (issue 7)
 void register_scenes(CLI::App& app, Context& context);    // cmd_run.cpp    (issue 7)
 
+/// --strict-weights: the one name of io::ImportOptions::strict_weights on every command that
+/// loads a model (scene files: model.strict_weights).
+inline void add_strict_weights(CLI::App* cmd, bool& strict) {
+  cmd->add_flag("--strict-weights", strict,
+                "refuse a model whose bone weights do not sum to 1 (default: normalize them "
+                "with one warning)");
+}
+
 /// The scene `conform` runs when given no arguments.
 const char* default_scene();
 /// Runs a scene (built-in name or file) into `out_dir` (empty: results/NAME); the exit code.

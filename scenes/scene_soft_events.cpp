@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <numbers>
 
 #include "conform/io/import.hpp"
@@ -373,6 +374,7 @@ class Character final : public Scene {
       model.fail("file", Json(file_), "no such file");
     animation_ = model.text("animation", "0");
     units_ = model.number("units_per_metre", 1, 1e-6, 1e6);
+    import_.strict_weights = model.boolean("strict_weights", false);
     model.finish();
     bullet::Material d;
     // Real characters come at any scale (units_per_metre) and their animations stretch the
@@ -393,7 +395,9 @@ class Character final : public Scene {
 
   Json run(RunOutput& out) override {
     CommonSettings c = common_;
-    io::SkinnedModel model = io::load_model(file_);
+    io::SkinnedModel model = io::load_model(file_, import_);
+    for (const auto& w : model.warnings)
+      std::cerr << "warning: " << model.source << ": " << w << "\n";
     const int a = model.find_animation(animation_);
     if (a < 0)
       throw std::runtime_error(file_ + ": no animation '" + animation_ + "' (" +
@@ -455,6 +459,7 @@ class Character final : public Scene {
 
  private:
   std::string file_, animation_;
+  io::ImportOptions import_;
   double units_ = 1;
   bullet::Material material_;
 };

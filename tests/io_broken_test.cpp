@@ -21,6 +21,7 @@ const std::string kBroken = std::string(CONFORM_TEST_DATA) + "/broken/";
 struct Broken {
   const char* file;
   const char* problem;  // a phrase the message must contain
+  bool strict = false;  // refused with ImportOptions::strict_weights (normalized by default)
 };
 
 class BrokenFile : public testing::TestWithParam<Broken> {};
@@ -29,8 +30,10 @@ TEST_P(BrokenFile, ThrowsImportErrorNamingFileAndProblem) {
   const Broken b = GetParam();
   const std::string path = kBroken + b.file;
   ASSERT_TRUE(std::filesystem::exists(path)) << path;
+  conform::io::ImportOptions options;
+  options.strict_weights = b.strict;
   try {
-    conform::io::import_model(path);
+    conform::io::import_model(path, options);
     FAIL() << "imported " << path;
   } catch (const ImportError& e) {
     const std::string what = e.what();
@@ -48,8 +51,8 @@ INSTANTIATE_TEST_SUITE_P(
                     Broken{"notes_renamed.fbx", "cannot be read"},
                     Broken{"notes_renamed.dae", "cannot be read"},
                     Broken{"simple_skin_nan_key.gltf", "NaN or infinite rotation key 3"},
-                    Broken{"simple_skin_bad_weights.gltf", "sum to 0.700000, not 1"},
-                    Broken{"simple_skin_bad_joint.gltf", "sum to 0.250000, not 1"},
+                    Broken{"simple_skin_bad_weights.gltf", "sum to 0.700000, not 1", true},
+                    Broken{"simple_skin_bad_joint.gltf", "sum to 0.250000, not 1", true},
                     Broken{"mesh.unknownformat", "unsupported format"}),
     [](const auto& info) {
       std::string n = info.param.file;
@@ -57,6 +60,19 @@ INSTANTIATE_TEST_SUITE_P(
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
       return n;
     });
+
+// Weights off 1 are normalized by default (issue 13: engines normalize on import), with one
+// warning that gives the range of the sums; strict_weights refuses them (above).
+TEST(IoBroken, WeightsOffOneAreNormalizedWithOneWarningByDefault) {
+  for (const char* file : {"simple_skin_bad_weights.gltf", "simple_skin_bad_joint.gltf"}) {
+    const auto m = conform::io::import_model(kBroken + file);
+    int warnings = 0;
+    for (const auto& w : m.warnings) warnings += w.find("do not sum to 1") != std::string::npos;
+    EXPECT_EQ(warnings, 1) << file;
+    for (Eigen::Index v = 0; v < m.mesh.vertex_count(); ++v)
+      EXPECT_NEAR(m.mesh.weights.col(v).sum(), 1.0, 1e-12) << file << " vertex " << v;
+  }
+}
 
 // The guard itself, on work whose fate is known: a crash in the child is reported by its signal
 // and leaves the caller running; work that returns or throws is not a crash.

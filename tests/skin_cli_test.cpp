@@ -94,21 +94,19 @@ TEST_F(SkinCli, BadArgumentsFail) {
 }
 
 // More than 4 influences: a real model with up to 6 per vertex (and weights summing to
-// 0.94–1.38, accepted with --weight-tolerance) skinned with 6 and with 4.
-TEST_F(SkinCli, MaxInfluencesAndWeightTolerance) {
+// 0.94–1.38, normalized by default, refused with --strict-weights) skinned with 6 and with 4.
+TEST_F(SkinCli, MaxInfluencesAndStrictWeights) {
   const std::string fbx = std::string(CONFORM_ASSIMP_MODELS) + "/FBX/animation_with_skeleton.fbx";
-  EXPECT_NE(run(fbx + " --time 0.4 --out " + (dir / "r.obj").string()), 0);  // default tolerance
-  io::ImportOptions o;
-  o.weight_tolerance = 0.5;
-  const auto model = io::import_model(fbx, o);
+  EXPECT_NE(run(fbx + " --time 0.4 --strict-weights --out " + (dir / "r.obj").string()), 0);
+  const auto model = io::import_model(fbx);
   skin::Pose pose;
   model.animations[0].sample(model.skeleton, 0.4, skin::Blend::log, pose);
   Eigen::Matrix3Xd four, six;
   for (int k : {4, 6}) {
     const fs::path out = dir / ("k" + std::to_string(k) + ".obj");
-    ASSERT_EQ(run(fbx + " --time 0.4 --weight-tolerance 0.5 --max-influences " + std::to_string(k) +
-                  " --out " + out.string()),
-              0);
+    ASSERT_EQ(
+        run(fbx + " --time 0.4 --max-influences " + std::to_string(k) + " --out " + out.string()),
+        0);
     skin::Skinner<double> s(model.skeleton, model.mesh.rest, model.influences, k);
     s.skin(pose, skin::SkinMode::cga);
     Eigen::Matrix3Xd expected;

@@ -3,18 +3,21 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
-#include <Eigen/SVD>
+#include <Eigen/LU>
 #include <algorithm>
 #include <assimp/Importer.hpp>
 #include <charconv>
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <unordered_map>
 
 #include "conform/io/crash_guard.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
+#include "similarity.hpp"
+#include "skinning_error.hpp"
 
 namespace conform::io {
 namespace {
@@ -28,194 +31,310 @@ Eigen::Matrix4d to_eigen(const aiMatrix4x4& m) {
   return e;
 }
 
-// A 4×4 affine matrix [A t; 0 1] as a versor: A = U Σ Vᵀ, rotation U Vᵀ (the polar factor, the
-// rotation nearest to A / scale), scale = mean singular value. Exact for a similarity; for a
-// non-uniform scale it is "the mean scale" of the issue and `nonuniform` is set.
-struct Decomposed {
-  Versor versor;
-  bool nonuniform = false;
-  bool reflection = false;
-};
-
-std::optional<Decomposed> decompose(const Eigen::Matrix4d& m) {
-  if (!m.allFinite()) return std::nullopt;
-  if (std::abs(m(3, 0)) > 1e-6 || std::abs(m(3, 1)) > 1e-6 || std::abs(m(3, 2)) > 1e-6 ||
-      std::abs(m(3, 3) - 1) > 1e-6)
-    return std::nullopt;
-  const Eigen::Matrix3d a = m.topLeftCorner<3, 3>();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(a, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  const Eigen::Vector3d sigma = svd.singularValues();
-  if (!(sigma.minCoeff() > 1e-12 * std::max(1.0, sigma.maxCoeff()))) return std::nullopt;
-  Eigen::Matrix3d u = svd.matrixU();
-  Decomposed d;
-  if ((u * svd.matrixV().transpose()).determinant() < 0) {
-    u.col(2) = -u.col(2);  // a mirror is not a versor: keep the proper rotation
-    d.reflection = true;
-  }
-  const Eigen::Matrix3d r = u * svd.matrixV().transpose();
-  const double s = sigma.mean();
-  d.nonuniform = (sigma.maxCoeff() - sigma.minCoeff()) > 1e-4 * s;
-  d.versor = Versor::from_trs(m.topRightCorner<3, 1>(), Eigen::Quaterniond(r).normalized(), s);
-  return d;
-}
-
 std::string node_name(const aiNode* n) {
   return n->mName.length ? n->mName.C_Str() : "(unnamed)";
 }
+
+// What the importer knows of a joint besides its versor: the file's global matrix at rest
+// (identity for a bone without a node), whether that global mirrors (its parity, conjugated
+// out of the versors with F), the versor of its global at rest, and whether every versor
+// from the root down to it is exact.
+struct JointFrame {
+  const aiNode* node = nullptr;  // null for a bone without a node
+  Eigen::Matrix4d global = Eigen::Matrix4d::Identity();
+  bool odd = false;
+  Versor global_versor;
+  bool exact_chain = true;
+  bool exact = true;  // its own versor
+  bool used = false;  // a bone's joint or one of their ancestors: it moves vertices
+};
+
+// Vertices whose weights do not sum to 1, over the whole model (one summary warning).
+struct WeightSums {
+  std::size_t off = 0;
+  double lowest = 1, highest = 1;
+};
+
+constexpr double kWeightSumNoise = 1e-4;  // |Σ w − 1| renormalized silently (float noise)
 
 struct Builder {
   std::string file;
   const aiScene* scene;
   ImportOptions options;
-  SkinnedModel model;
-  std::unordered_map<std::string, std::int32_t> joint_by_name;
-  std::vector<std::int32_t> mesh_node;  // first node (DFS) referencing each mesh, −1 if none
-  std::vector<Eigen::Matrix4d> offset_matrices;  // per bone, for de-duplication
+  SkinnedModel model{};
+  std::unordered_map<std::string, std::int32_t> joint_by_name{};
+  std::vector<JointFrame> frames{};               // per joint
+  std::vector<detail::MeshInstance> instances{};  // every (mesh, node) placement
+  std::vector<Eigen::Matrix4d> bone_keys{};       // per bone, O K⁻¹, for de-duplication
+  std::vector<std::string> approximated{};        // transforms that are not proper similarities
+  WeightSums sums{};
 
   [[noreturn]] void fail(const std::string& problem) const { throw ImportError(file, problem); }
   void warn(const std::string& w) { model.warnings.push_back(w); }
 
-  Versor to_versor(const aiMatrix4x4& m, const std::string& what) {
-    const auto d = decompose(to_eigen(m));
+  // The nearest versor; an approximation is recorded, or returned in `exact` when given.
+  Versor to_versor(const Eigen::Matrix4d& m, const std::string& what, bool* exact = nullptr) {
+    const auto d = detail::nearest_versor(m);
     if (!d) fail(what + " has a NaN, singular or projective transform");
-    if (d->nonuniform) warn(what + ": non-uniform scale replaced by its mean (not a versor)");
-    if (d->reflection)
-      warn(what + ": mirroring transform; the reflection is dropped (not a versor)");
+    if (exact)
+      *exact = d->exact;
+    else if (!d->exact)
+      approximated.push_back(what);
     return d->versor;
   }
 
+  // Marks `joint` and its ancestors as moving vertices; their approximated versors count.
+  void use(std::int32_t joint) {
+    for (auto j = joint; j >= 0; j = model.skeleton.joints[static_cast<std::size_t>(j)].parent) {
+      JointFrame& f = frames[static_cast<std::size_t>(j)];
+      if (f.used) return;
+      f.used = true;
+      if (!f.exact)
+        approximated.push_back("node '" + model.skeleton.joints[static_cast<std::size_t>(j)].name +
+                               "'");
+    }
+  }
+
+  // Every node becomes a joint. A mirroring node makes its subtree odd: its versor is the
+  // proper F^parent L F^self, so that the versors' product along a chain is G F^odd. The
+  // parent is the node's mParent when that was visited already: assimp's HL1 MDL loader
+  // lists a bone chain as siblings whose mParent pointers hold the real chain (and the
+  // offsets match that), e.g. MDL/MDL (HL1)/man.mdl.
   void walk(const aiNode* node, std::int32_t parent) {
     const auto index = static_cast<std::int32_t>(model.skeleton.joints.size());
+    if (node->mParent && parent >= 0 &&
+        frames[static_cast<std::size_t>(parent)].node != node->mParent)
+      for (std::int32_t j = 0; j < index; ++j)
+        if (frames[static_cast<std::size_t>(j)].node == node->mParent) parent = j;
+    const Eigen::Matrix4d local = to_eigen(node->mTransformation);
+    JointFrame f;
+    f.node = node;
+    const bool parent_odd = parent >= 0 && frames[static_cast<std::size_t>(parent)].odd;
+    f.odd = parent_odd != (local.topLeftCorner<3, 3>().determinant() < 0);
+    f.global = parent >= 0
+                   ? Eigen::Matrix4d(frames[static_cast<std::size_t>(parent)].global * local)
+                   : local;
     skin::Joint j;
     j.name = node_name(node);
     j.parent = parent;
-    j.rest = to_versor(node->mTransformation, "node '" + j.name + "'");
-    model.skeleton.joints.push_back(std::move(j));
-    joint_by_name.emplace(node->mName.C_Str(), index);  // the first node of a name wins
-    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
-      const unsigned m = node->mMeshes[i];
-      if (m < mesh_node.size() && mesh_node[m] < 0) mesh_node[m] = index;
+    j.rest =
+        to_versor(detail::reflected(local, parent_odd, f.odd), "node '" + j.name + "'", &f.exact);
+    f.exact_chain = f.exact;
+    if (parent >= 0) {
+      const JointFrame& p = frames[static_cast<std::size_t>(parent)];
+      f.global_versor = p.global_versor * j.rest;
+      f.exact_chain = f.exact && p.exact_chain;
+    } else {
+      f.global_versor = j.rest;
     }
+    model.skeleton.joints.push_back(std::move(j));
+    frames.push_back(f);
+    joint_by_name.emplace(node->mName.C_Str(), index);  // the first node of a name wins
+    for (unsigned i = 0; i < node->mNumMeshes; ++i)
+      if (node->mMeshes[i] < scene->mNumMeshes) instances.push_back({node->mMeshes[i], node});
     for (unsigned c = 0; c < node->mNumChildren; ++c) walk(node->mChildren[c], index);
   }
 
-  std::int32_t bone_for(const aiBone* b, const std::string& mesh_name) {
-    const std::string name = b->mName.C_Str();
-    auto it = joint_by_name.find(name);
-    if (it == joint_by_name.end()) {
-      // No node of that name (e.g. X/anim_test.x's joint3, joint4): the bone gets a root joint
-      // of its own placed at its bind pose, G = B⁻¹, so that it holds its vertices where they
-      // are unless an animation channel of that name moves it.
-      const Versor offset = to_versor(b->mOffsetMatrix, "offset of bone '" + name + "'");
-      const auto inv = offset.inverse();
-      if (!inv) fail("offset of bone '" + name + "' is singular");
-      skin::Joint j;
-      j.name = name;
-      j.rest = *inv;
-      model.skeleton.joints.push_back(j);
-      it = joint_by_name.emplace(name, model.skeleton.joint_count() - 1).first;
-      warn("bone '" + name + "' of mesh '" + mesh_name +
-           "' has no node of that name; it stays at its bind pose");
+  // Instances in mesh order (a mesh's instances in node order); a mesh no node places gets one
+  // instance at the root.
+  void order_instances() {
+    std::vector<detail::MeshInstance> ordered;
+    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+      const auto before = ordered.size();
+      for (const auto& in : instances)
+        if (in.mesh == m) ordered.push_back(in);
+      if (ordered.size() == before) {
+        const aiMesh* am = scene->mMeshes[m];
+        warn("mesh '" + (am->mName.length ? std::string(am->mName.C_Str()) : std::to_string(m)) +
+             "' is not referenced by any node; placed at the root");
+        ordered.push_back({m, scene->mRootNode});
+      }
     }
-    const Eigen::Matrix4d off = to_eigen(b->mOffsetMatrix);
+    instances = std::move(ordered);
+  }
+
+  std::int32_t joint_of(const aiNode* node) const {
+    for (std::size_t j = 0; j < frames.size(); ++j)
+      if (frames[j].node == node) return static_cast<std::int32_t>(j);
+    return 0;
+  }
+
+  // A bone without a node of its name (e.g. X/anim_test.x's joint3, joint4) gets a root
+  // joint of its own at its bind pose (O⁻¹), so that it holds its vertices where they are
+  // unless an animation channel of that name moves it.
+  std::int32_t nodeless_joint(const aiBone* b, const std::string& mesh_name) {
+    const std::string name = b->mName.C_Str();
+    const std::string what = "offset of bone '" + name + "'";
+    const auto inv = to_versor(to_eigen(b->mOffsetMatrix), what).inverse();
+    if (!inv) fail(what + " is singular");
+    skin::Joint j;
+    j.name = name;
+    j.rest = *inv;
+    model.skeleton.joints.push_back(j);
+    JointFrame f;
+    f.global_versor = *inv;
+    frames.push_back(f);
+    warn("bone '" + name + "' of mesh '" + mesh_name +
+         "' has no node of that name; it stays at its bind pose");
+    return joint_by_name.emplace(name, model.skeleton.joint_count() - 1).first->second;
+  }
+
+  // The skinning matrix of a bone on `joint` with file offset `offset` at the rest pose, in
+  // baked space: G O N⁻¹ (a bone without a node: N⁻¹, matrix skinning leaves it in place).
+  Eigen::Matrix4d rest_skinning(std::int32_t joint, const Eigen::Matrix4d& offset,
+                                const Eigen::Matrix4d& bake_inverse) const {
+    const JointFrame& f = frames[static_cast<std::size_t>(joint)];
+    return f.node ? Eigen::Matrix4d(f.global * offset * bake_inverse) : bake_inverse;
+  }
+
+  // The bone (joint, O N⁻¹), shared by meshes that bind it alike. Below a chain of exact
+  // versors its versor is that of F^odd O N⁻¹ (G̃ F^odd = G exactly). Below a chain with an
+  // approximated node it is B = G̃⁻¹ · versor(G O N⁻¹), G̃ the joint's global versor at rest:
+  // the rest pose is then still exact (whenever G O N⁻¹ is a proper similarity).
+  std::int32_t bone(std::int32_t joint, const std::string& name, const Eigen::Matrix4d& offset,
+                    const Eigen::Matrix4d& bake_inverse) {
+    const Eigen::Matrix4d key = offset * bake_inverse;
     for (std::size_t i = 0; i < model.skeleton.bones.size(); ++i)
-      if (model.skeleton.bones[i].joint == it->second && offset_matrices[i] == off)
+      if (model.skeleton.bones[i].joint == joint && bone_keys[i] == key)
         return static_cast<std::int32_t>(i);
-    skin::Bone bone;
-    bone.name = name;
-    bone.joint = it->second;
-    bone.offset = to_versor(b->mOffsetMatrix, "offset of bone '" + name + "'");
-    model.skeleton.bones.push_back(bone);
-    offset_matrices.push_back(off);
+    use(joint);
+    const JointFrame& f = frames[static_cast<std::size_t>(joint)];
+    const std::string what = "bind transform of bone '" + name + "'";
+    skin::Bone b;
+    b.name = name;
+    b.joint = joint;
+    if (f.exact_chain) {
+      b.offset = to_versor(detail::reflected(key, f.odd, false), what);
+    } else {
+      const auto inv = f.global_versor.inverse();
+      if (!inv) fail("node '" + name + "' has a singular transform");
+      b.offset = *inv * to_versor(rest_skinning(joint, offset, bake_inverse), what);
+    }
+    model.skeleton.bones.push_back(b);
+    bone_keys.push_back(key);
     return static_cast<std::int32_t>(model.skeleton.bones.size() - 1);
   }
 
-  std::int32_t rigid_bone(std::int32_t joint) {
-    const Eigen::Matrix4d id = Eigen::Matrix4d::Identity();
-    for (std::size_t i = 0; i < model.skeleton.bones.size(); ++i)
-      if (model.skeleton.bones[i].joint == joint && offset_matrices[i] == id)
-        return static_cast<std::int32_t>(i);
-    skin::Bone bone;
-    bone.name = model.skeleton.joints[static_cast<std::size_t>(joint)].name;
-    bone.joint = joint;
-    model.skeleton.bones.push_back(bone);
-    offset_matrices.push_back(id);
-    return static_cast<std::int32_t>(model.skeleton.bones.size() - 1);
+  // The bind transform K of an instance: the mesh node's global transform when it makes
+  // every bone's rest skinning matrix G O K⁻¹ a proper similarity (the usual case); else the
+  // bind transform its first bone's offset implies (G O: a file whose offsets ignore a
+  // mirroring mesh node, as X/test_cube_*.x); else the node's, with the bones' transforms
+  // approximated.
+  Eigen::Matrix4d bind_transform(const detail::MeshInstance& in) {
+    const aiMesh* am = scene->mMeshes[in.mesh];
+    const Eigen::Matrix4d node = frames[static_cast<std::size_t>(joint_of(in.node))].global;
+    if (am->mNumBones == 0) return node;
+    std::vector<std::pair<std::int32_t, Eigen::Matrix4d>> bones;
+    for (unsigned i = 0; i < am->mNumBones; ++i) {
+      const auto it = joint_by_name.find(am->mBones[i]->mName.C_Str());
+      if (it != joint_by_name.end() && frames[static_cast<std::size_t>(it->second)].node)
+        bones.push_back({it->second, to_eigen(am->mBones[i]->mOffsetMatrix)});
+    }
+    const auto all_similar = [&](const Eigen::Matrix4d& k) {
+      const Eigen::Matrix4d inv = k.inverse();
+      if (!inv.allFinite()) return false;
+      for (const auto& [joint, offset] : bones)
+        if (!detail::is_proper_similarity(rest_skinning(joint, offset, inv))) return false;
+      return true;
+    };
+    if (bones.empty() || all_similar(node)) return node;
+    const Eigen::Matrix4d implied =
+        frames[static_cast<std::size_t>(bones.front().first)].global * bones.front().second;
+    return all_similar(implied) ? implied : node;
   }
 
-  // Every mesh of the scene into one SkinnedMesh: vertices, triangles and bone weights, each
-  // checked (indices in range, finite values, weights summing to 1).
+  // What of K is baked into the rest positions: N = Q⁻¹ K, Q the nearest proper similarity
+  // to K, which the versors carry. N is the identity (and nothing is baked) when K is a proper
+  // similarity, its non-uniform stretch or mirror otherwise.
+  static Eigen::Matrix4d baked_part(const Eigen::Matrix4d& k) {
+    const auto q = detail::nearest_versor(k);
+    if (!q || q->exact) return Eigen::Matrix4d::Identity();
+    return q->versor.matrix().inverse() * k;
+  }
+
+  // Every instance of every mesh into one SkinnedMesh: vertices (baked), triangles and bone
+  // weights, each checked (indices in range, finite values, weights summing to 1).
   void meshes() {
+    order_instances();
     auto& mesh = model.mesh;
     std::size_t nv = 0, nf = 0;
-    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-      nv += scene->mMeshes[m]->mNumVertices;
-      nf += scene->mMeshes[m]->mNumFaces;
+    bool all_normals = true, all_uvs = true;
+    for (const auto& in : instances) {
+      const aiMesh* am = scene->mMeshes[in.mesh];
+      nv += am->mNumVertices, nf += am->mNumFaces;
+      all_normals = all_normals && am->HasNormals();
+      all_uvs = all_uvs && am->HasTextureCoords(0);
     }
     if (nv >= static_cast<std::size_t>(INT32_MAX)) fail("too many vertices");
     mesh.rest.resize(3, static_cast<Eigen::Index>(nv));
     mesh.faces.reserve(nf);
-    bool all_normals = true, all_uvs = true;
-    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-      all_normals = all_normals && scene->mMeshes[m]->HasNormals();
-      all_uvs = all_uvs && scene->mMeshes[m]->HasTextureCoords(0);
-    }
     if (all_normals) mesh.normals.resize(3, static_cast<Eigen::Index>(nv));
     if (all_uvs) mesh.uvs.resize(2, static_cast<Eigen::Index>(nv));
 
     Influences inf(nv);
     std::int32_t base = 0;
     std::size_t skipped = 0;
-    for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
-      const aiMesh* am = scene->mMeshes[m];
+    for (auto& in : instances) {
+      const aiMesh* am = scene->mMeshes[in.mesh];
       MeshInfo info;
-      info.name = am->mName.length ? am->mName.C_Str() : "mesh " + std::to_string(m);
+      info.name = am->mName.length ? am->mName.C_Str() : "mesh " + std::to_string(in.mesh);
+      info.source = static_cast<std::int32_t>(in.mesh);
       info.first_vertex = base;
       info.vertex_count = static_cast<std::int32_t>(am->mNumVertices);
       info.first_face = static_cast<std::int32_t>(mesh.faces.size());
       info.bones = static_cast<std::int32_t>(am->mNumBones);
-      info.joint = mesh_node[m];
-      if (info.joint < 0) {
-        warn("mesh '" + info.name + "' is not referenced by any node; placed at the root");
-        info.joint = 0;
-      }
-      vertices(am, info, base, all_normals, all_uvs);
-      skipped += triangles(am, info, base);
+      info.joint = joint_of(in.node);
+      in.first_vertex = base;
+      in.bake = baked_part(bind_transform(in));
+      vertices(am, info, base, in.bake, all_normals, all_uvs);
+      skipped += triangles(am, info, base, in.bake.topLeftCorner<3, 3>().determinant() < 0);
       info.face_count = static_cast<std::int32_t>(mesh.faces.size()) - info.first_face;
-      weights(am, info, base, inf);
+      weights(am, info, base, in.bake.inverse(), inf);
       model.meshes.push_back(info);
       base += info.vertex_count;
     }
     if (skipped) warn(std::to_string(skipped) + " point or line primitives ignored");
     if (mesh.faces.empty()) fail("contains no triangles");
+    if (sums.off)
+      warn("the bone weights of " + std::to_string(sums.off) + " vertices do not sum to 1 (" +
+           std::to_string(sums.lowest) + " to " + std::to_string(sums.highest) +
+           "); renormalized (strict weights would refuse the model)");
     store_influences(inf, nv);
   }
 
   // Every vertex's bone influences, before the shared mesh keeps the 4 largest.
   using Influences = std::vector<std::vector<std::pair<std::int32_t, double>>>;
 
-  void vertices(const aiMesh* am, const MeshInfo& info, std::int32_t base, bool all_normals,
-                bool all_uvs) {
+  // Positions baked by K, normals by K's inverse transpose (renormalized).
+  void vertices(const aiMesh* am, const MeshInfo& info, std::int32_t base,
+                const Eigen::Matrix4d& bake, bool all_normals, bool all_uvs) {
     auto& mesh = model.mesh;
+    const Eigen::Matrix3d a = bake.topLeftCorner<3, 3>();
+    const Eigen::Vector3d t = bake.topRightCorner<3, 1>();
+    const Eigen::Matrix3d normal_map = a.inverse().transpose();
     for (unsigned v = 0; v < am->mNumVertices; ++v) {
       const aiVector3D& p = am->mVertices[v];
       const Eigen::Vector3d x(p.x, p.y, p.z);
       if (!x.allFinite())
         fail("mesh '" + info.name + "' vertex " + std::to_string(v) + " is NaN or infinite");
-      mesh.rest.col(base + static_cast<std::int32_t>(v)) = x;
+      const auto col = base + static_cast<std::int32_t>(v);
+      mesh.rest.col(col) = a * x + t;
       if (all_normals) {
         const aiVector3D& n = am->mNormals[v];
-        mesh.normals.col(base + static_cast<std::int32_t>(v)) = Eigen::Vector3d(n.x, n.y, n.z);
+        const Eigen::Vector3d baked = normal_map * Eigen::Vector3d(n.x, n.y, n.z);
+        const double length = baked.norm();
+        mesh.normals.col(col) = length > 0 ? Eigen::Vector3d(baked / length) : baked;
       }
       if (all_uvs) {
-        const aiVector3D& t = am->mTextureCoords[0][v];
-        mesh.uvs.col(base + static_cast<std::int32_t>(v)) = Eigen::Vector2d(t.x, t.y);
+        const aiVector3D& uv = am->mTextureCoords[0][v];
+        mesh.uvs.col(col) = Eigen::Vector2d(uv.x, uv.y);
       }
     }
   }
 
-  // The mesh's triangles, indices checked; returns how many other primitives were skipped.
-  std::size_t triangles(const aiMesh* am, const MeshInfo& info, std::int32_t base) {
+  // The mesh's triangles, indices checked (wound the other way when K mirrors, so that faces
+  // keep facing their normals); returns how many other primitives were skipped.
+  std::size_t triangles(const aiMesh* am, const MeshInfo& info, std::int32_t base, bool mirrored) {
     auto& mesh = model.mesh;
     std::size_t skipped = 0;
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
@@ -231,57 +350,65 @@ struct Builder {
                std::to_string(face.mIndices[k]) + " of " + std::to_string(am->mNumVertices));
         tri[static_cast<std::size_t>(k)] = base + static_cast<std::int32_t>(face.mIndices[k]);
       }
+      if (mirrored) std::swap(tri[1], tri[2]);
       mesh.faces.push_back(tri);
     }
     return skipped;
   }
 
-  // The mesh's bone weights (one rigid bone for a mesh without bones), checked and
-  // renormalized.
-  void weights(const aiMesh* am, const MeshInfo& info, std::int32_t base, Influences& inf) {
+  // The mesh's bone weights (one rigid bone on its node for a mesh without bones), checked and
+  // normalized.
+  void weights(const aiMesh* am, const MeshInfo& info, std::int32_t base,
+               const Eigen::Matrix4d& bake_inverse, Influences& inf) {
     if (am->mNumBones == 0) {
-      const auto b = rigid_bone(info.joint);
+      const auto b =
+          bone(info.joint, model.skeleton.joints[static_cast<std::size_t>(info.joint)].name,
+               Eigen::Matrix4d::Identity(), bake_inverse);
       for (unsigned v = 0; v < am->mNumVertices; ++v)
         inf[static_cast<std::size_t>(base) + v].push_back({b, 1.0});
-    } else {
-      for (unsigned i = 0; i < am->mNumBones; ++i) {
-        const aiBone* ab = am->mBones[i];
-        const auto b = bone_for(ab, info.name);
-        for (unsigned k = 0; k < ab->mNumWeights; ++k) {
-          const aiVertexWeight& w = ab->mWeights[k];
-          if (w.mVertexId >= am->mNumVertices)
-            fail("bone '" + std::string(ab->mName.C_Str()) + "' of mesh '" + info.name +
-                 "' refers to vertex " + std::to_string(w.mVertexId) + " of " +
-                 std::to_string(am->mNumVertices));
-          if (!std::isfinite(w.mWeight) || w.mWeight < 0)
-            fail("bone '" + std::string(ab->mName.C_Str()) + "' of mesh '" + info.name +
-                 "' has a NaN, infinite or negative weight");
-          if (w.mWeight > 0)
-            inf[static_cast<std::size_t>(base) + w.mVertexId].push_back({b, w.mWeight});
-        }
-      }
-      // Weights must sum to 1. Exporters truncating to 4 influences without renormalizing
-      // leave sums a little below 1 (FBX/huesitos.fbx: 0.948–1); those are renormalized with
-      // a warning, anything further off is an error.
-      std::size_t off = 0;
-      double worst = 1;
-      for (unsigned v = 0; v < am->mNumVertices; ++v) {
-        auto& list = inf[static_cast<std::size_t>(base) + v];
-        double sum = 0;
-        for (const auto& bw : list) sum += bw.second;
-        if (std::abs(sum - 1) > options.weight_tolerance)
-          fail("the bone weights of vertex " + std::to_string(v) + " of mesh '" + info.name +
-               "' sum to " + std::to_string(sum) + ", not 1");
-        if (std::abs(sum - 1) > 1e-4) {
-          ++off;
-          if (std::abs(sum - 1) > std::abs(worst - 1)) worst = sum;
-        }
-        for (auto& bw : list) bw.second /= sum;
-      }
-      if (off)
-        warn("mesh '" + info.name + "': the weights of " + std::to_string(off) +
-             " vertices do not sum to 1 (worst " + std::to_string(worst) + "); renormalized");
+      return;
     }
+    for (unsigned i = 0; i < am->mNumBones; ++i) {
+      const aiBone* ab = am->mBones[i];
+      const std::string name = ab->mName.C_Str();
+      auto it = joint_by_name.find(name);
+      const std::int32_t joint =
+          it != joint_by_name.end() ? it->second : nodeless_joint(ab, info.name);
+      const auto b = bone(joint, name, to_eigen(ab->mOffsetMatrix), bake_inverse);
+      for (unsigned k = 0; k < ab->mNumWeights; ++k) {
+        const aiVertexWeight& w = ab->mWeights[k];
+        if (w.mVertexId >= am->mNumVertices)
+          fail("bone '" + name + "' of mesh '" + info.name + "' refers to vertex " +
+               std::to_string(w.mVertexId) + " of " + std::to_string(am->mNumVertices));
+        if (!std::isfinite(w.mWeight) || w.mWeight < 0)
+          fail("bone '" + name + "' of mesh '" + info.name +
+               "' has a NaN, infinite or negative weight");
+        if (w.mWeight > 0)
+          inf[static_cast<std::size_t>(base) + w.mVertexId].push_back({b, w.mWeight});
+      }
+    }
+    for (unsigned v = 0; v < am->mNumVertices; ++v)
+      normalize(inf[static_cast<std::size_t>(base) + v], v, info);
+  }
+
+  // Weights must sum to 1. Exporters truncating influences without renormalizing, or Blender
+  // exports (FBX/animation_with_skeleton.fbx: 0.94–1.38), do not; engines normalize on import,
+  // and so does this by default. With strict_weights a sum off by more than float noise is an
+  // error. A vertex without any weight cannot be skinned at all.
+  void normalize(std::vector<std::pair<std::int32_t, double>>& list, unsigned v,
+                 const MeshInfo& info) {
+    double sum = 0;
+    for (const auto& bw : list) sum += bw.second;
+    const std::string vertex = "vertex " + std::to_string(v) + " of mesh '" + info.name + "'";
+    if (!(sum > 0)) fail("the bones of " + vertex + " give it no weight");
+    if (std::abs(sum - 1) > kWeightSumNoise) {
+      if (options.strict_weights)
+        fail("the bone weights of " + vertex + " sum to " + std::to_string(sum) +
+             ", not 1 (strict weights)");
+      ++sums.off;
+      sums.lowest = std::min(sums.lowest, sum), sums.highest = std::max(sums.highest, sum);
+    }
+    for (auto& bw : list) bw.second /= sum;
   }
 
   // The influence lists, and the shared mesh's 4 largest (renormalized, sorted decreasing).
@@ -296,7 +423,6 @@ struct Builder {
       }
       lists.offsets.push_back(static_cast<std::int32_t>(lists.bones.size()));
     }
-    // The shared mesh keeps the 4 largest, renormalized, sorted decreasing.
     const auto four = skin::Influences<double>::select(lists, mesh::kMaxInfluences);
     mesh.bones.resize(mesh::kMaxInfluences, static_cast<Eigen::Index>(nv));
     mesh.weights.resize(mesh::kMaxInfluences, static_cast<Eigen::Index>(nv));
@@ -307,6 +433,52 @@ struct Builder {
         mesh.weights(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(v)) =
             four.weights[k * nv + v];
       }
+  }
+
+  // One node channel as keys of the joint's versor F^parent L(t) F^self: translations and
+  // rotations reflected, scale vectors made positive by a constant rotation folded into the
+  // rotation keys (a sign pattern with an even number of flips is a half turn).
+  skin::Channel channel(const aiNodeAnim* na, std::int32_t joint, const std::string& what) {
+    const JointFrame& f = frames[static_cast<std::size_t>(joint)];
+    const std::int32_t parent = model.skeleton.joints[static_cast<std::size_t>(joint)].parent;
+    const bool left = parent >= 0 && frames[static_cast<std::size_t>(parent)].odd;
+    skin::Channel ch;
+    ch.joint = joint;
+    for (unsigned k = 0; k < na->mNumPositionKeys; ++k) {
+      const auto& key = na->mPositionKeys[k];
+      Eigen::Vector3d t(key.mValue.x, key.mValue.y, key.mValue.z);
+      if (left) t.z() = -t.z();
+      ch.translation.push_back({key.mTime, t});
+    }
+    // The sign pattern of F^parent S F^self, from the first scale key.
+    Eigen::Vector3d signs(1, 1, left != f.odd ? -1 : 1);
+    if (na->mNumScalingKeys) {
+      const auto& s = na->mScalingKeys[0].mValue;
+      signs =
+          signs.cwiseProduct(Eigen::Vector3d(s.x < 0 ? -1 : 1, s.y < 0 ? -1 : 1, s.z < 0 ? -1 : 1));
+    }
+    bool inexact = signs.prod() < 0;  // the animation changes the node's parity
+    Eigen::Matrix3d flips = Eigen::Matrix3d::Identity();
+    if (signs.prod() > 0) flips = signs.asDiagonal();
+    const Eigen::Quaterniond half_turn(flips);
+    for (unsigned k = 0; k < na->mNumRotationKeys; ++k) {
+      const auto& key = na->mRotationKeys[k];
+      Eigen::Quaterniond q(key.mValue.w, key.mValue.x, key.mValue.y, key.mValue.z);
+      if (left) q = detail::reflected(q);
+      ch.rotation.push_back({key.mTime, q * half_turn});
+    }
+    for (unsigned k = 0; k < na->mNumScalingKeys; ++k) {
+      const auto& key = na->mScalingKeys[k];
+      Eigen::Vector3d s(key.mValue.x, key.mValue.y, key.mValue.z);
+      if (left != f.odd) s.z() = -s.z();
+      const Eigen::Vector3d positive = s.cwiseProduct(signs);
+      if (!positive.allFinite() || positive.minCoeff() <= 0 ||
+          positive.maxCoeff() - positive.minCoeff() > 1e-5 * positive.mean())
+        inexact = true;
+      ch.scale.push_back({key.mTime, s.allFinite() ? positive.cwiseAbs().mean() : s.mean()});
+    }
+    if (inexact && f.used) approximated.push_back(what);
+    return ch;
   }
 
   void animations() {
@@ -324,36 +496,33 @@ struct Builder {
           warn("animation '" + anim.name + "': channel for unknown node '" + node + "' ignored");
           continue;
         }
-        skin::Channel ch;
-        ch.joint = it->second;
-        for (unsigned k = 0; k < na->mNumPositionKeys; ++k) {
-          const auto& key = na->mPositionKeys[k];
-          ch.translation.push_back(
-              {key.mTime, Eigen::Vector3d(key.mValue.x, key.mValue.y, key.mValue.z)});
-        }
-        for (unsigned k = 0; k < na->mNumRotationKeys; ++k) {
-          const auto& key = na->mRotationKeys[k];
-          ch.rotation.push_back({key.mTime, Eigen::Quaterniond(key.mValue.w, key.mValue.x,
-                                                               key.mValue.y, key.mValue.z)});
-        }
-        bool warned = false;
-        for (unsigned k = 0; k < na->mNumScalingKeys; ++k) {
-          const auto& key = na->mScalingKeys[k];
-          const Eigen::Vector3d s(key.mValue.x, key.mValue.y, key.mValue.z);
-          const double mean = s.mean();
-          if (!warned && s.allFinite() && (s.maxCoeff() - s.minCoeff()) > 1e-4 * std::abs(mean)) {
-            warn("animation '" + anim.name + "', node '" + node +
-                 "': non-uniform scale keys replaced by their mean (not a versor)");
-            warned = true;
-          }
-          ch.scale.push_back({key.mTime, mean});
-        }
-        anim.channels.push_back(std::move(ch));
+        anim.channels.push_back(
+            channel(na, it->second, "animation '" + anim.name + "', node '" + node + "'"));
       }
       if (const auto e = anim.validate(model.skeleton); !e.empty()) fail(e);
       model.animations.push_back(std::move(anim));
     }
   }
+
+  // When some transform is not a proper similarity, CGA skinning may differ from matrix
+  // skinning: measure by how much, and say so when it is more than rounding.
+  void report_approximations() {
+    if (approximated.empty()) return;
+    const auto e = detail::skinning_error(*scene, model, instances);
+    if (!(e.worst > kExactSkinning * e.diagonal)) return;
+    std::string list;
+    for (std::size_t i = 0; i < approximated.size() && i < 4; ++i)
+      list += (i ? ", " : "") + approximated[i];
+    if (approximated.size() > 4) list += ", ... (" + std::to_string(approximated.size()) + ")";
+    std::ostringstream os;
+    os << "non-uniform scales or mirrors that versors cannot represent (" << list
+       << ") are approximated by the nearest similarity: skinning deviates from matrix skinning "
+          "by up to "
+       << e.worst / e.diagonal << " of the model's diagonal (" << e.worst << " units, at "
+       << e.where << ")";
+    warn(os.str());
+  }
+  static constexpr double kExactSkinning = 1e-6;  // float storage: files are exact to ~1e-7
 };
 
 // The bind pose in world space: every node at its own transform, skinned with eq 17.
@@ -415,16 +584,16 @@ SkinnedModel import_model(const std::filesystem::path& path, const ImportOptions
     throw ImportError(file, "incomplete scene (no mesh data)");
   if (scene->mNumMeshes == 0) throw ImportError(file, "contains no meshes");
 
-  Builder b{file, scene, options, {}, {}, std::vector<std::int32_t>(scene->mNumMeshes, -1), {}};
+  Builder b{file, scene, options};
   b.model.source = file;
   b.walk(scene->mRootNode, -1);
   b.meshes();
   b.animations();
   if (const auto e = b.model.skeleton.validate(); !e.empty()) b.fail(e);
-  if (const auto e =
-          b.model.influences.validate(b.model.skeleton.bone_count(), options.weight_tolerance);
+  if (const auto e = b.model.influences.validate(b.model.skeleton.bone_count(), kWeightSumNoise);
       !e.empty())
     b.fail(e);
+  b.report_approximations();
   pose_current(b.model);
   return std::move(b.model);
 }

@@ -5,20 +5,34 @@
 // - assimp post-processing: triangulate, join identical vertices, validate the data
 //   structure (import_flags()); no weight limiting — every influence is kept.
 // - Every node of the scene becomes a joint (depth-first, parents first), with its own
-//   transform as a versor; every aiBone becomes a bone on the node of the same name with its
-//   offset matrix as versor B_n. A mesh without bones becomes one rigid bone on its node
-//   (identity offset). A bone without a node of its name gets a root joint of its own at its
-//   bind pose (B_n⁻¹), with a warning.
-// - Influences: all kept (SkinnedModel::influences), each vertex's weights renormalized to
-//   sum 1 (a warning when they were off by more than 1e-4; an error beyond
-//   ImportOptions::weight_tolerance).
-// - Transforms are decomposed as T R S; a non-uniform scale is not a versor, so its mean is
-//   used and a warning is recorded once per node, offset or channel.
+//   transform as a versor; every aiBone becomes a bone on the node of the same name. A mesh
+//   without bones becomes one rigid bone on its node. A bone without a node of its name gets a
+//   root joint of its own at its bind pose (O⁻¹), with a warning. A mesh placed by several
+//   nodes is imported once per node (MeshInfo::source names the file's mesh).
+// - Exact bind transforms: matrix skinning is x' = Σ w G_b O_b x (G_b the bone node's global
+//   matrix, O_b its offset). A mesh's bind transform K is its node's global transform, or,
+//   when the file's offsets ignore that node (X/test_cube_*.x), the one its first bone's
+//   offset implies (G_b O_b); with it every bone's rest skinning matrix G_b O_b K⁻¹ is a
+//   proper similarity. K = Q N, Q the nearest proper similarity, which the versors carry; N,
+//   the non-uniform stretch or mirror, is baked into the rest positions, x_rest = N x
+//   (normals by N⁻ᵀ, faces rewound when N mirrors; nothing is baked when K is a similarity).
+//   A mirroring node makes its subtree odd: its joints store F^parent L F^self with
+//   F = diag(1, 1, −1) (animation keys alike), which is proper, and the mirrors cancel in
+//   G_b O_b. A bone below an approximated node gets B_b = G̃_b⁻¹ · (G_b O_b N⁻¹), G̃_b its
+//   joint's global versor at rest, so the rest pose stays exact. What cannot be exact is a
+//   non-uniform scale that an animation really moves (animated, or above an animated bone)
+//   or a key that changes a node's parity: the nearest similarity is used, and the importer
+//   measures the result against matrix skinning of the file at the rest pose and every key
+//   time and warns with the largest deviation relative to the model's diagonal.
+// - Influences: all kept (SkinnedModel::influences). Each vertex's weights are normalized to
+//   sum 1; sums off by more than 1e-4 (exports that truncate influences, Blender's 0.94–1.38)
+//   give one summary warning, or with ImportOptions::strict_weights an error. A vertex whose
+//   bones give it no weight is an error.
 // - Animations: position, rotation and scaling keys per node channel, times in ticks;
 //   ticks per second 25 when the file says 0.
 // - Errors (missing file, unsupported format, unreadable or truncated file, no meshes, NaN
-//   transforms or keys, weights not summing to 1, bone or vertex ids out of range) throw
-//   ImportError whose message starts with the file name.
+//   transforms or keys, strict weights not summing to 1, bone or vertex ids out of range)
+//   throw ImportError whose message starts with the file name.
 #pragma once
 
 #include <filesystem>
@@ -41,9 +55,10 @@ class ImportError : public std::runtime_error {
 };
 
 struct ImportOptions {
-  /// Largest |Σ w − 1| of a skinned vertex before import fails; sums off by more than 1e-4
-  /// but within this are renormalized with a warning.
-  double weight_tolerance = 0.1;
+  /// Refuse a vertex whose bone weights do not sum to 1 (to 1e-4) instead of normalizing it
+  /// with a summary warning (the command line's --strict-weights, scene files'
+  /// model.strict_weights).
+  bool strict_weights = false;
   /// Read the file once in a forked child process first (POSIX), so that a file on which
   /// assimp itself crashes (assimp 5.2 segfaults or aborts on out-of-range bone or vertex
   /// indices in .x and .dae files) gives an ImportError instead of killing the caller. Costs
