@@ -46,6 +46,12 @@ struct SolverSettings {
   void validate() const;
 };
 
+/// A 3 x 0 matrix that outlives every StepInput (the default of its optional fields).
+inline const Eigen::Matrix3Xd& no_columns() {
+  static const Eigen::Matrix3Xd none(3, 0);
+  return none;
+}
+
 struct StepInput {
   /// Skinned targets T (3 x #V) and their unit normals (3 x #V, or empty: isotropic k_t).
   Eigen::Ref<const Eigen::Matrix3Xd> targets;
@@ -61,7 +67,7 @@ struct StepInput {
   /// The predicted positions xp of the inertia term (3 x #V), or empty: x's given values are
   /// the prediction. A host that knows a better initial guess than the prediction (e.g. the last
   /// solution moved with the targets) passes the prediction here and its guess in x.
-  Eigen::Ref<const Eigen::Matrix3Xd> predicted = Eigen::Matrix3Xd(3, 0);
+  Eigen::Ref<const Eigen::Matrix3Xd> predicted = no_columns();
   /// Node masses, kg (empty: rho_A times the node's rest area). A host whose edits split and
   /// conserve mass (the Bullet plugin) passes its own books, so inertia and momentum agree.
   std::span<const double> masses = {};
