@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "conform/io/crash_guard.hpp"
+#include "conform/io/weld_model.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 
@@ -425,6 +426,7 @@ SkinnedModel import_model(const std::filesystem::path& path, const ImportOptions
           b.model.influences.validate(b.model.skeleton.bone_count(), options.weight_tolerance);
       !e.empty())
     b.fail(e);
+  if (options.weld) weld_model(b.model, options.weld_options);
   pose_current(b.model);
   return std::move(b.model);
 }
