@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "conform/io/crash_guard.hpp"
+#include "conform/io/weld_model.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 #include "similarity.hpp"
@@ -593,7 +594,8 @@ SkinnedModel import_model(const std::filesystem::path& path, const ImportOptions
   if (const auto e = b.model.influences.validate(b.model.skeleton.bone_count(), kWeightSumNoise);
       !e.empty())
     b.fail(e);
-  b.report_approximations();
+  b.report_approximations();  // on the file's own vertices, before the weld renumbers them
+  if (options.weld) weld_model(b.model, options.weld_options);
   pose_current(b.model);
   return std::move(b.model);
 }

@@ -2,11 +2,14 @@
 
 #include <unistd.h>
 
+#include <Eigen/Core>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -31,6 +34,10 @@ namespace {
 struct Selection {
   std::vector<std::int32_t> vertices;  // old index of each written vertex
   std::vector<mesh::Face> faces;       // in the new numbering
+  std::vector<std::int32_t> face_ids;  // the mesh face of each written face
+  // Per written vertex, when the mesh has corner attributes (split_wedges); else empty.
+  Eigen::Matrix2Xd uvs;
+  Eigen::Matrix3Xd normals;
 };
 
 Selection select(const mesh::SkinnedMesh& mesh, std::span<const std::int32_t> faces) {
@@ -44,6 +51,8 @@ Selection select(const mesh::SkinnedMesh& mesh, std::span<const std::int32_t> fa
     s.vertices.resize(static_cast<std::size_t>(nv));
     for (std::int32_t i = 0; i < nv; ++i) s.vertices[static_cast<std::size_t>(i)] = i;
     s.faces = mesh.faces;
+    s.face_ids.resize(mesh.faces.size());
+    for (std::size_t f = 0; f < s.faces.size(); ++f) s.face_ids[f] = std::int32_t(f);
     for (const auto& f : s.faces) check_face(f);
     return s;
   }
@@ -63,12 +72,51 @@ Selection select(const mesh::SkinnedMesh& mesh, std::span<const std::int32_t> fa
       s.vertices.push_back(i);
     }
   s.faces.reserve(faces.size());
+  s.face_ids.assign(faces.begin(), faces.end());
   for (auto fi : faces) {
     const auto& f = mesh.faces[static_cast<std::size_t>(fi)];
     s.faces.push_back({remap[static_cast<std::size_t>(f[0])], remap[static_cast<std::size_t>(f[1])],
                        remap[static_cast<std::size_t>(f[2])]});
   }
   return s;
+}
+
+// A welded mesh's seams written back: one written vertex per distinct (vertex, corner UV,
+// corner normal), numbered in order of first use by the faces' corners.
+void split_wedges(const mesh::SkinnedMesh& mesh, Selection& s) {
+  const bool uvs = mesh.has_corner_uvs(), normals = mesh.has_corner_normals();
+  if (!uvs && !normals) return;
+  struct Wedge {
+    std::int32_t vertex;
+    std::array<double, 5> value;
+    bool operator<(const Wedge& o) const {
+      return vertex != o.vertex ? vertex < o.vertex : value < o.value;
+    }
+  };
+  std::map<Wedge, std::int32_t> index;
+  std::vector<std::int32_t> vertices;
+  std::vector<Wedge> wedges;
+  for (std::size_t i = 0; i < s.faces.size(); ++i) {
+    const auto f = static_cast<Eigen::Index>(s.face_ids[i]);
+    for (int k = 0; k < 3; ++k) {
+      Wedge w{s.vertices[std::size_t(s.faces[i][std::size_t(k)])], {0, 0, 0, 0, 0}};
+      for (int j = 0; uvs && j < 2; ++j) w.value[std::size_t(j)] = mesh.corner_uvs(2 * k + j, f);
+      for (int j = 0; normals && j < 3; ++j)
+        w.value[std::size_t(2 + j)] = mesh.corner_normals(3 * k + j, f);
+      const auto [it, fresh] = index.try_emplace(w, std::int32_t(wedges.size()));
+      if (fresh) wedges.push_back(w);
+      s.faces[i][std::size_t(k)] = it->second;
+    }
+  }
+  s.vertices.resize(wedges.size());
+  if (uvs) s.uvs.resize(2, Eigen::Index(wedges.size()));
+  if (normals) s.normals.resize(3, Eigen::Index(wedges.size()));
+  for (std::size_t i = 0; i < wedges.size(); ++i) {
+    s.vertices[i] = wedges[i].vertex;
+    const auto c = static_cast<Eigen::Index>(i);
+    if (uvs) s.uvs.col(c) << wedges[i].value[0], wedges[i].value[1];
+    if (normals) s.normals.col(c) << wedges[i].value[2], wedges[i].value[3], wedges[i].value[4];
+  }
 }
 
 template <class T>
@@ -87,51 +135,71 @@ void add(std::string& out, double v, bool space = true) {
   out.append(buf, static_cast<std::size_t>(n));
 }
 
-std::string encode(const mesh::SkinnedMesh& mesh, const Selection& s, const MeshExportOptions& o) {
-  const auto& pos = o.rest_positions ? mesh.rest : mesh.current;
-  if (pos.cols() != mesh.vertex_count())
-    throw std::runtime_error("mesh export: position matrix does not match the vertex count");
-  const bool uvs = o.uvs && mesh.has_uvs();
-  std::string out;
-  if (o.format == MeshFormat::Obj) {
-    out += "# conform mesh export\n";
-    for (auto v : s.vertices) {
-      out += "v";
-      for (int k = 0; k < 3; ++k) add(out, pos(k, v));
-      out += "\n";
-    }
-    if (uvs)
-      for (auto v : s.vertices)
-        out += "vt", add(out, mesh.uvs(0, v)), add(out, mesh.uvs(1, v)), out += "\n";
-    for (const auto& f : s.faces) {
-      out += "f";
-      for (auto v : f) {
-        const std::string i = std::to_string(v + 1);
-        out.append(" ").append(i);
-        if (uvs) out.append("/").append(i);
-      }
-      out += "\n";
-    }
-    return out;
+// What each written vertex carries: UVs and normals of its corner (a welded mesh) or of the
+// vertex; normals only from corner normals (a mesh without seams writes none, as before).
+struct Attributes {
+  const mesh::SkinnedMesh& mesh;
+  const Selection& s;
+  bool uvs, normals;
+  Attributes(const mesh::SkinnedMesh& m, const Selection& sel, const MeshExportOptions& o)
+      : mesh(m),
+        s(sel),
+        uvs(o.uvs && (sel.uvs.cols() > 0 || m.has_uvs())),
+        normals(o.normals && sel.normals.cols() > 0) {}
+  double uv(std::size_t i, int k) const {
+    return s.uvs.cols() > 0 ? s.uvs(k, Eigen::Index(i)) : mesh.uvs(k, s.vertices[i]);
   }
-  const bool binary = o.format == MeshFormat::PlyBinary;
-  out += "ply\nformat ";
+  double normal(std::size_t i, int k) const { return s.normals(k, Eigen::Index(i)); }
+};
+
+std::string encode_obj(const Eigen::Ref<const Eigen::Matrix3Xd>& pos, const Attributes& a) {
+  std::string out = "# conform mesh export\n";
+  const auto& s = a.s;
+  for (auto v : s.vertices) {
+    out += "v";
+    for (int k = 0; k < 3; ++k) add(out, pos(k, v));
+    out += "\n";
+  }
+  for (std::size_t i = 0; a.uvs && i < s.vertices.size(); ++i)
+    out += "vt", add(out, a.uv(i, 0)), add(out, a.uv(i, 1)), out += "\n";
+  for (std::size_t i = 0; a.normals && i < s.vertices.size(); ++i)
+    out += "vn", add(out, a.normal(i, 0)), add(out, a.normal(i, 1)), add(out, a.normal(i, 2)),
+        out += "\n";
+  for (const auto& f : s.faces) {
+    out += "f";
+    for (auto v : f) {
+      const std::string i = std::to_string(v + 1);
+      out.append(" ").append(i);
+      if (a.uvs || a.normals) out.append("/");
+      if (a.uvs) out.append(i);
+      if (a.normals) out.append("/").append(i);
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+std::string encode_ply(const Eigen::Ref<const Eigen::Matrix3Xd>& pos, const Attributes& a,
+                       bool binary) {
+  const auto& s = a.s;
+  std::string out = "ply\nformat ";
   out += binary ? "binary_little_endian" : "ascii";
   out += " 1.0\ncomment conform mesh export\n";
   out += "element vertex " + std::to_string(s.vertices.size()) + "\n";
   out += "property double x\nproperty double y\nproperty double z\n";
-  if (uvs) out += "property double s\nproperty double t\n";
+  if (a.uvs) out += "property double s\nproperty double t\n";
+  if (a.normals) out += "property double nx\nproperty double ny\nproperty double nz\n";
   out += "element face " + std::to_string(s.faces.size()) + "\n";
   out += "property list uchar int vertex_indices\nend_header\n";
-  for (auto v : s.vertices) {
-    if (binary) {
-      for (int k = 0; k < 3; ++k) put(out, pos(k, v));
-      if (uvs) put(out, mesh.uvs(0, v)), put(out, mesh.uvs(1, v));
-    } else {
-      add(out, pos(0, v), false), add(out, pos(1, v)), add(out, pos(2, v));
-      if (uvs) add(out, mesh.uvs(0, v)), add(out, mesh.uvs(1, v));
-      out += "\n";
-    }
+  for (std::size_t i = 0; i < s.vertices.size(); ++i) {
+    std::array<double, 8> values{};
+    int n = 0;
+    for (int k = 0; k < 3; ++k) values[std::size_t(n++)] = pos(k, s.vertices[i]);
+    for (int k = 0; a.uvs && k < 2; ++k) values[std::size_t(n++)] = a.uv(i, k);
+    for (int k = 0; a.normals && k < 3; ++k) values[std::size_t(n++)] = a.normal(i, k);
+    for (int k = 0; k < n; ++k)
+      binary ? put(out, values[std::size_t(k)]) : add(out, values[std::size_t(k)], k > 0);
+    if (!binary) out += "\n";
   }
   for (const auto& f : s.faces) {
     if (binary) {
@@ -147,11 +215,22 @@ std::string encode(const mesh::SkinnedMesh& mesh, const Selection& s, const Mesh
   return out;
 }
 
+std::string encode(const mesh::SkinnedMesh& mesh, const Selection& s, const MeshExportOptions& o) {
+  const auto& pos = o.rest_positions ? mesh.rest : mesh.current;
+  if (pos.cols() != mesh.vertex_count())
+    throw std::runtime_error("mesh export: position matrix does not match the vertex count");
+  const Attributes attributes(mesh, s, o);
+  if (o.format == MeshFormat::Obj) return encode_obj(pos, attributes);
+  return encode_ply(pos, attributes, o.format == MeshFormat::PlyBinary);
+}
+
 }  // namespace
 
 void write_mesh(const std::filesystem::path& path, const mesh::SkinnedMesh& mesh,
                 const MeshExportOptions& options, std::span<const std::int32_t> faces) {
-  const std::string data = encode(mesh, select(mesh, faces), options);
+  Selection selection = select(mesh, faces);
+  split_wedges(mesh, selection);
+  const std::string data = encode(mesh, selection, options);
   // A unique temporary name in the target's directory, so that rename() is atomic.
   static std::atomic<unsigned> counter{0};
   std::filesystem::path tmp = path;

@@ -2,6 +2,8 @@
 
 #include "conform/mesh/detail/apply_steps.hpp"
 
+#include "conform/mesh/corner_attributes.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -159,6 +161,9 @@ void apply_vertices(SkinnedMesh& mesh, const TopologyChange& change) {
 
 void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency) {
   const auto& added = change.added_faces;
+  // The added faces' corner attributes, computed while the removed faces are still there.
+  const AddedCorners corners = added_corner_attributes(mesh, change);
+  const bool corner_uvs = mesh.has_corner_uvs(), corner_normals = mesh.has_corner_normals();
   if (adjacency)
     for (auto f : change.removed_faces) adjacency->remove_face(mesh, f);
   const std::size_t filled = std::min(change.removed_faces.size(), added.size());
@@ -167,8 +172,21 @@ void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adj
     Adjacency* adjacency;
     const std::vector<Face>& added;
     std::size_t filled;
+    const AddedCorners& corners;
+    bool uvs, normals;
+    // The corner attributes follow their face through every slot operation.
+    void set_corners(std::int32_t slot, std::size_t k) {
+      const auto col = static_cast<Eigen::Index>(k);
+      if (uvs) mesh.corner_uvs.col(slot) = corners.uvs.col(col);
+      if (normals) mesh.corner_normals.col(slot) = corners.normals.col(col);
+    }
+    void resize_corners(std::int32_t faces) {
+      if (uvs) mesh.corner_uvs.conservativeResize(6, faces);
+      if (normals) mesh.corner_normals.conservativeResize(9, faces);
+    }
     void fill(std::int32_t slot, std::size_t k) {
       mesh.faces[static_cast<std::size_t>(slot)] = added[k];
+      set_corners(slot, k);
       if (adjacency) adjacency->add_face(mesh, slot);
     }
     void append(std::int32_t slot, std::size_t k) {
@@ -180,18 +198,24 @@ void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adj
         adjacency->resize_faces(
             static_cast<std::int32_t>(mesh.faces.size() + (added.size() - filled)));
       mesh.faces.push_back(added[k]);
+      resize_corners(mesh.face_count());
+      set_corners(slot, k);
       if (adjacency) adjacency->add_face(mesh, slot);
     }
     void move(std::int32_t last, std::int32_t slot) {
       mesh.faces[static_cast<std::size_t>(slot)] = mesh.faces.back();
+      if (uvs) mesh.corner_uvs.col(slot) = mesh.corner_uvs.col(last);
+      if (normals) mesh.corner_normals.col(slot) = mesh.corner_normals.col(last);
       if (adjacency) adjacency->move_face(mesh, last, slot);
     }
     void pop(std::int32_t) {
       mesh.faces.pop_back();
+      resize_corners(mesh.face_count());
       if (adjacency) adjacency->resize_faces(mesh.face_count());
     }
   };
-  visit_face_slots(change, Slots{mesh, adjacency, added, filled});
+  visit_face_slots(change,
+                   Slots{mesh, adjacency, added, filled, corners, corner_uvs, corner_normals});
 }
 
 }  // namespace detail

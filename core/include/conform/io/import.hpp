@@ -30,6 +30,8 @@
 //   bones give it no weight is an error.
 // - Animations: position, rotation and scaling keys per node channel, times in ticks;
 //   ticks per second 25 when the file says 0.
+// - Welding (ImportOptions::weld, on by default): each mesh's vertices at one position become
+//   one vertex; UVs and normals are kept per face corner (SkinnedMesh::corner_uvs/normals).
 // - Errors (missing file, unsupported format, unreadable or truncated file, no meshes, NaN
 //   transforms or keys, strict weights not summing to 1, bone or vertex ids out of range)
 //   throw ImportError whose message starts with the file name.
@@ -40,6 +42,7 @@
 #include <string>
 
 #include "conform/io/model.hpp"
+#include "conform/mesh/weld.hpp"
 
 namespace conform::io {
 
@@ -65,6 +68,11 @@ struct ImportOptions {
   /// a second read. Off by default: forking a multithreaded host is only safe when no other
   /// thread holds a lock the child needs; the `conform` command turns it on.
   bool crash_guard = false;
+  /// Weld each mesh's vertices at one position, keeping UVs and normals per face corner
+  /// (io/weld_model.hpp, mesh/weld.hpp: the tolerance is relative to the bounding-box diagonal;
+  /// vertices whose weights differ stay apart).
+  bool weld = true;
+  mesh::WeldOptions weld_options;
 };
 
 /// The assimp post-processing flags used by import_model (aiPostProcessSteps bits).

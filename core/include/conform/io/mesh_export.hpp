@@ -1,5 +1,11 @@
 // Export of a SkinnedMesh's positions as PLY (binary little-endian or ASCII) or OBJ.
 //
+// Seams. A mesh with corner attributes (a welded import, skinned_mesh.hpp) is written with
+// one vertex per distinct (vertex, corner UV, corner normal), numbered in order of first use
+// by the faces' corners: the seams as the file had them. Per-vertex UVs are then not used, and
+// the corner normals are written too. A mesh without corner attributes is written as before:
+// one vertex per vertex, its UVs, no normals.
+//
 // Files are written atomically: the data go to a temporary file in the same directory, which
 // is renamed over the target only once it is complete, so a reader never sees half a mesh.
 #pragma once
@@ -21,6 +27,8 @@ struct MeshExportOptions {
   bool rest_positions = false;
   /// Write UVs when the mesh has them (PLY: s, t properties; OBJ: vt lines).
   bool uvs = true;
+  /// Write normals when the mesh has corner normals (PLY: nx, ny, nz; OBJ: vn lines).
+  bool normals = true;
 };
 
 /// "ply" (binary), "ply-ascii" or "obj"; throws std::invalid_argument otherwise.

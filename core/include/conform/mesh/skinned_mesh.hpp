@@ -9,6 +9,16 @@
 //   weights    4 × #V  their weights, sorted decreasing, summing to 1, unused slots 0
 //   uvs        2 × #V  or empty
 //   normals    3 × #V  rest-space normals, or empty
+//   corner_uvs      6 × #F  per face corner ("wedge") UVs (u0 v0 u1 v1 u2 v2), or empty
+//   corner_normals  9 × #F  per face corner rest-space normals (corner 0's xyz first), or empty
+//
+// Per-vertex and per-corner attributes. A file split at its UV and normal seams is welded on
+// import (weld.hpp): one vertex per position for simulation and topology, while the corner
+// arrays keep each face's own UVs and normals, so that the seams survive into the written and
+// rendered mesh (mesh_export.hpp splits vertices by corner again). The per-vertex uvs/normals
+// then hold one representative value (see weld.hpp). Meshes built without seams (the
+// procedural arm) have no corner arrays. The corner arrays follow the faces through every
+// TopologyChange (corner_attributes.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -34,11 +44,17 @@ struct SkinnedMesh {
   ColumnArray<double, kMaxInfluences> weights;
   ColumnArray<double, 2> uvs;
   ColumnArray<double, 3> normals;
+  ColumnArray<double, 6> corner_uvs;
+  ColumnArray<double, 9> corner_normals;
 
   std::int32_t vertex_count() const { return static_cast<std::int32_t>(rest.cols()); }
   std::int32_t face_count() const { return static_cast<std::int32_t>(faces.size()); }
   bool has_uvs() const { return uvs.cols() == rest.cols() && uvs.cols() > 0; }
   bool has_normals() const { return normals.cols() == rest.cols() && normals.cols() > 0; }
+  bool has_corner_uvs() const { return corner_uvs.cols() == face_count() && face_count() > 0; }
+  bool has_corner_normals() const {
+    return corner_normals.cols() == face_count() && face_count() > 0;
+  }
 };
 
 }  // namespace conform::mesh

@@ -1,0 +1,56 @@
+// Welding a mesh that arrives split at its UV and normal seams: vertices at one position become
+// one vertex, so that simulation and topology see one surface, while each face keeps its own
+// corner UVs and normals (SkinnedMesh::corner_uvs / corner_normals), so that the seams survive.
+//
+// The rule.
+// - Two vertices are at one position when their rest positions are within
+//   `tolerance` × the diagonal of the rest positions' bounding box (default 1e-7), and they are
+//   in the same group (the io layer welds each mesh of a file on its own: a mesh's vertices
+//   share one space, and MeshInfo's vertex ranges stay contiguous). Measured on the rigged
+//   assimp-testmodels: 1e-7 and below weld exactly the bit-equal seam copies; 3e-7 and 1e-6
+//   also weld distinct nearby vertices of X/Testwuson.X and SMD/WusonSMD.smd (10 and 14 edges
+//   then used by more than two faces).
+// - Bone weights. Coincident vertices weld only when their (up to 4) influences agree: the
+//   largest difference of one bone's weight is at most `weight_tolerance` (default 1e-3).
+//   Otherwise they stay apart, so that neither vertex skins differently from the file (the
+//   seam may then open as they deform). Measured: X/Testwuson.X keeps 7 of its 2124 vertices
+//   apart (welding them anyway leaves its 51 pieces), X/BCN_Epileptic.X 1; the other rigged
+//   models none (mesh_weld_test.cpp).
+// - Greedy and deterministic: vertices are visited in index order and each joins the first
+//   (lowest-index) kept vertex it matches, else is kept itself. Kept vertices keep their
+//   relative order; a kept vertex keeps its own rest and current position, influences and UV;
+//   its per-vertex normal becomes the renormalized sum of its cluster's normals.
+// - Faces whose corners weld together (collapsed to a line or point) are dropped.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "conform/mesh/skinned_mesh.hpp"
+
+namespace conform::mesh {
+
+struct WeldOptions {
+  /// Relative to the rest positions' bounding-box diagonal.
+  double tolerance = 1e-7;
+  /// Largest difference of one bone's weight between two vertices that weld.
+  double weight_tolerance = 1e-3;
+};
+
+struct WeldResult {
+  std::vector<std::int32_t> vertex_map;  // old vertex → new vertex
+  std::vector<std::int32_t> face_map;    // old face → new face, −1 when it collapsed
+  std::vector<std::int32_t> kept;        // new vertex → the old vertex it keeps
+  std::int32_t merged = 0;               // vertices welded into another one
+  std::int32_t kept_apart = 0;           // vertices left apart at a welded position (weights)
+  std::int32_t collapsed_faces = 0;
+};
+
+/// Welds `mesh` in place (see above). `group` is empty (one group) or gives each vertex's group.
+/// First fills the corner arrays from the per-vertex UVs and normals when they are empty.
+/// Throws std::invalid_argument on a negative tolerance or a group array of the wrong size.
+WeldResult weld(SkinnedMesh& mesh, const WeldOptions& options = {},
+                std::span<const std::int32_t> group = {});
+
+}  // namespace conform::mesh
