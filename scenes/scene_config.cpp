@@ -6,9 +6,39 @@ namespace conform::scenes {
 
 const Json Reader::kEmpty = Json::object();
 
+namespace {
+constexpr std::size_t kShownChars = 60;
+constexpr int kShownDepth = 8;
+
+// Like Json::dump() without spaces, but its recursion stops at kShownDepth levels and once
+// the text is longer than what is shown: Json::dump() recurses as deep as the input nests,
+// and a scene file nested 100,000 deep overflowed the stack while its error was printed.
+void append_shown(const Json& value, int depth, std::string& out) {
+  if (!value.is_structured()) {
+    out += value.dump();
+    return;
+  }
+  const bool array = value.is_array();
+  if (depth >= kShownDepth && !value.empty()) {
+    out += array ? "[...]" : "{...}";
+    return;
+  }
+  out += array ? '[' : '{';
+  bool first = true;
+  for (auto it = value.begin(); it != value.end() && out.size() <= kShownChars; ++it) {
+    if (!first) out += ',';
+    first = false;
+    if (!array) out += Json(it.key()).dump() + ':';
+    append_shown(it.value(), depth + 1, out);
+  }
+  out += array ? ']' : '}';
+}
+}  // namespace
+
 std::string show(const Json& value) {
-  std::string s = value.dump();
-  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  std::string s;
+  append_shown(value, 0, s);
+  if (s.size() > kShownChars) s = s.substr(0, kShownChars - 3) + "...";
   return s;
 }
 

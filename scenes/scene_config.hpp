@@ -33,7 +33,8 @@ class SceneError : public std::runtime_error {
   std::string key_, value_, reason_;
 };
 
-/// A short printable form of a JSON value for error messages.
+/// A short printable form of a JSON value for error messages: at most 60 characters, and
+/// nesting below 8 levels shown as [...] or {...}, so any input prints in bounded time and stack.
 std::string show(const Json& value);
 
 /// Strict reader of one JSON object. `resolved` receives every value read (defaults included).

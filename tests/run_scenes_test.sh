@@ -19,9 +19,10 @@ expect_error() {  # expect_error <stderr pattern> <args...>
   local pattern="$1"; shift
   local out="$tmp/bad"
   rm -rf "$out"
-  if "$conform" run "$@" --out "$out" > "$tmp/stdout" 2> "$tmp/stderr"; then
-    fail "run $* should fail"
-  fi
+  local rc=0
+  "$conform" run "$@" --out "$out" > "$tmp/stdout" 2> "$tmp/stderr" || rc=$?
+  [[ $rc -ne 0 ]] || fail "run $* should fail"
+  [[ $rc -lt 128 ]] || fail "run $* died of a signal (rc $rc) instead of an error"
   grep -q -- "$pattern" "$tmp/stderr" || { cat "$tmp/stderr" >&2; fail "run $*: no '$pattern' in the error"; }
   [[ ! -e "$out" ]] || fail "run $* wrote $out despite the error"
 }
@@ -38,6 +39,10 @@ printf '{ "scene": "arm-track", ' > "$tmp/broken.json"
 expect_error "not valid JSON" "$tmp/broken.json"
 printf '{ "scene": "arm-track", "seed": "seven" }' > "$tmp/badseed.json"
 expect_error "key 'seed', value \"seven\": must be an integer" "$tmp/badseed.json"
+# A value nested 100,000 deep: printing it for the error overflowed the stack (rc 139).
+python3 -c 'print("{\"scene\": \"arm-track\", \"seed\": " + "[" * 100000 + "]" * 100000 + "}")' \
+  > "$tmp/deep.json"
+expect_error "key 'seed', value \[\[\[\[\[\[\[\[\[...\]\]\]\]\]\]\]\]\]: must be an integer" "$tmp/deep.json"
 
 # A short run from a scene file: every output, and the same numbers twice.
 cp "$tmp/arm.json" "$tmp/my-arm.json"
