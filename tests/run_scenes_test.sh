@@ -44,6 +44,10 @@ python3 -c 'print("{\"scene\": \"arm-track\", \"seed\": " + "[" * 100000 + "]" *
   > "$tmp/deep.json"
 expect_error "key 'seed', value \[\[\[\[\[\[\[\[\[...\]\]\]\]\]\]\]\]\]: must be an integer" "$tmp/deep.json"
 
+# 2^32 steps (42949.67296 s / 1e-5 s) wrapped to a 1-step run that exited 0.
+expect_error "key 'duration', value 42949.67296: with physics.dt = 1e-05 gives 4294967296 steps, more than the limit of 100000000" \
+  arm-track --set duration=42949.67296 --set physics.dt=1e-5
+
 # A short run from a scene file: every output, and the same numbers twice.
 cp "$tmp/arm.json" "$tmp/my-arm.json"
 for run in a b; do
