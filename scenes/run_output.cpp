@@ -31,7 +31,8 @@ CommonSettings read_common(Reader& root, const std::string& name, double default
   c.dt = physics.number("dt", c.dt, 1e-5, 0.1);
   c.substeps = physics.integer("substeps", c.substeps, 1, 1000);
   c.solver_iterations = physics.integer("solver_iterations", c.solver_iterations, 1, 1000);
-  c.gravity = physics.vec3("gravity", c.gravity);
+  // At most 100 g: -1e300 is finite but made every body's motion non-finite (and exited 0).
+  c.gravity = physics.vec3("gravity", c.gravity, kMaxGravity);
   // Physics keys a scene kind may read later stay unread here; the kind finishes the object.
   physics.finish();
   Reader outputs = root.object("outputs");

@@ -39,6 +39,9 @@ struct Plot {
 /// step index in an int, and is over a day of wall time even at 1 ms a step.
 inline constexpr int kMaxSteps = 100000000;
 
+/// The largest gravity a scene may set, m/s² (about 100 g).
+inline constexpr double kMaxGravity = 1000;
+
 struct CommonSettings {
   std::string name;  // scene name (built-in name or file stem)
   std::string kind;  // the scene's "scene" key

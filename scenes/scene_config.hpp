@@ -52,7 +52,9 @@ class Reader {
   bool boolean(const std::string& key, bool fallback);
   std::string text(const std::string& key, const std::string& fallback,
                    std::initializer_list<const char*> allowed = {});
-  Eigen::Vector3d vec3(const std::string& key, const Eigen::Vector3d& fallback);
+  /// An array of 3 finite numbers whose length is at most `max_norm`.
+  Eigen::Vector3d vec3(const std::string& key, const Eigen::Vector3d& fallback,
+                       double max_norm = kInf);
   /// An array of exactly two numbers, each in [min, max].
   std::array<double, 2> pair(const std::string& key, const std::array<double, 2>& fallback,
                              double min = -kInf, double max = kInf);
@@ -87,6 +89,9 @@ class Reader {
 
  private:
   void mark(const std::string& key) { used_.insert(key); }
+  /// The one finiteness check of every number read: `c` is `value` or one of its elements.
+  double finite(const std::string& key, const Json& value, const Json& c,
+                const std::string& reason) const;
   const Json* get(const std::string& key);
 
   const Json* object_;

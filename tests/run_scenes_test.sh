@@ -47,6 +47,9 @@ expect_error "key 'seed', value \[\[\[\[\[\[\[\[\[...\]\]\]\]\]\]\]\]\]: must be
 # 2^32 steps (42949.67296 s / 1e-5 s) wrapped to a 1-step run that exited 0.
 expect_error "key 'duration', value 42949.67296: with physics.dt = 1e-05 gives 4294967296 steps, more than the limit of 100000000" \
   arm-track --set duration=42949.67296 --set physics.dt=1e-5
+# A finite but huge gravity made the results non-finite, with exit 0.
+expect_error "key 'physics.gravity', value \[0,-1e+300,0\]: its length must be at most 1000" \
+  arm-track --set 'physics.gravity=[0,-1e300,0]'
 
 # A short run from a scene file: every output, and the same numbers twice.
 cp "$tmp/arm.json" "$tmp/my-arm.json"
