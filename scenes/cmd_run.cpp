@@ -89,7 +89,7 @@ void register_run(CLI::App& app, Context& context) {
       ->required();
   cmd->add_option("--out", args->out, "output folder (default: results/SCENE)");
   cmd->add_option("--steps", args->steps, "number of steps (default: the scene's duration / dt)")
-      ->check(CLI::Range(1, 100000000));
+      ->check(CLI::Range(1, scenes::kMaxSteps));
   cmd->add_option("--set", args->sets, "override a scene key, e.g. --set physics.dt=0.005")
       ->allow_extra_args(false);
   cmd->callback([&context, args]() {

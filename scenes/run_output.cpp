@@ -31,7 +31,8 @@ CommonSettings read_common(Reader& root, const std::string& name, double default
   c.dt = physics.number("dt", c.dt, 1e-5, 0.1);
   c.substeps = physics.integer("substeps", c.substeps, 1, 1000);
   c.solver_iterations = physics.integer("solver_iterations", c.solver_iterations, 1, 1000);
-  c.gravity = physics.vec3("gravity", c.gravity);
+  // At most 100 g: -1e300 is finite but made every body's motion non-finite (and exited 0).
+  c.gravity = physics.vec3("gravity", c.gravity, kMaxGravity);
   // Physics keys a scene kind may read later stay unread here; the kind finishes the object.
   physics.finish();
   Reader outputs = root.object("outputs");
@@ -39,8 +40,14 @@ CommonSettings read_common(Reader& root, const std::string& name, double default
   c.frames_every = outputs.integer("frames_every", 0, 0, 1000000);
   c.plots = outputs.boolean("plots", true);
   outputs.finish();
-  c.steps = steps_override > 0 ? steps_override
-                               : std::max(1, static_cast<int>(std::lround(duration / c.dt)));
+  // In double first: int(duration / dt) overflowed to a 1-step run that reported success.
+  const double steps = std::max(1.0, std::round(duration / c.dt));
+  if (steps_override <= 0 && steps > kMaxSteps)
+    throw SceneError("duration", show(Json(duration)),
+                     "with physics.dt = " + show(Json(c.dt)) + " gives " +
+                         std::to_string(static_cast<long long>(steps)) +
+                         " steps, more than the limit of " + std::to_string(kMaxSteps));
+  c.steps = steps_override > 0 ? steps_override : static_cast<int>(steps);
   return c;
 }
 

@@ -35,6 +35,13 @@ struct Plot {
 };
 
 /// Common settings every scene reads (physics, outputs, seed, length).
+/// The most steps a run may take (duration / dt or --steps): 10^8 keeps every step count and
+/// step index in an int, and is over a day of wall time even at 1 ms a step.
+inline constexpr int kMaxSteps = 100000000;
+
+/// The largest gravity a scene may set, m/s² (about 100 g).
+inline constexpr double kMaxGravity = 1000;
+
 struct CommonSettings {
   std::string name;  // scene name (built-in name or file stem)
   std::string kind;  // the scene's "scene" key

@@ -6,9 +6,39 @@ namespace conform::scenes {
 
 const Json Reader::kEmpty = Json::object();
 
+namespace {
+constexpr std::size_t kShownChars = 60;
+constexpr int kShownDepth = 8;
+
+// Like Json::dump() without spaces, but its recursion stops at kShownDepth levels and once
+// the text is longer than what is shown: Json::dump() recurses as deep as the input nests,
+// and a scene file nested 100,000 deep overflowed the stack while its error was printed.
+void append_shown(const Json& value, int depth, std::string& out) {
+  if (!value.is_structured()) {
+    out += value.dump();
+    return;
+  }
+  const bool array = value.is_array();
+  if (depth >= kShownDepth && !value.empty()) {
+    out += array ? "[...]" : "{...}";
+    return;
+  }
+  out += array ? '[' : '{';
+  bool first = true;
+  for (auto it = value.begin(); it != value.end() && out.size() <= kShownChars; ++it) {
+    if (!first) out += ',';
+    first = false;
+    if (!array) out += Json(it.key()).dump() + ':';
+    append_shown(it.value(), depth + 1, out);
+  }
+  out += array ? ']' : '}';
+}
+}  // namespace
+
 std::string show(const Json& value) {
-  std::string s = value.dump();
-  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  std::string s;
+  append_shown(value, 0, s);
+  if (s.size() > kShownChars) s = s.substr(0, kShownChars - 3) + "...";
   return s;
 }
 
@@ -41,13 +71,18 @@ std::string range_text(double min, double max) {
 }
 }  // namespace
 
+double Reader::finite(const std::string& key, const Json& value, const Json& c,
+                      const std::string& reason) const {
+  if (!c.is_number() || !std::isfinite(c.get<double>())) fail(key, value, reason);
+  return c.get<double>();
+}
+
 double Reader::number(const std::string& key, double fallback, double min, double max) {
   const Json* v = get(key);
   double x = fallback;
   if (v) {
     if (!v->is_number()) fail(key, *v, "must be a number");
-    x = v->get<double>();
-    if (!std::isfinite(x)) fail(key, *v, "must be finite");
+    x = finite(key, *v, *v, "must be finite");
     if (x < min || x > max) fail(key, *v, range_text(min, max));
   }
   (*resolved_)[key] = x;
@@ -106,17 +141,18 @@ std::string Reader::text(const std::string& key, const std::string& fallback,
   return x;
 }
 
-Eigen::Vector3d Reader::vec3(const std::string& key, const Eigen::Vector3d& fallback) {
+Eigen::Vector3d Reader::vec3(const std::string& key, const Eigen::Vector3d& fallback,
+                             double max_norm) {
   const Json* v = get(key);
   Eigen::Vector3d x = fallback;
   if (v) {
     if (!v->is_array() || v->size() != 3) fail(key, *v, "must be an array of 3 numbers");
-    for (int i = 0; i < 3; ++i) {
-      const Json& c = (*v)[static_cast<std::size_t>(i)];
-      if (!c.is_number() || !std::isfinite(c.get<double>()))
-        fail(key, *v, "must be an array of 3 finite numbers");
-      x[i] = c.get<double>();
-    }
+    for (int i = 0; i < 3; ++i)
+      x[i] = finite(key, *v, (*v)[static_cast<std::size_t>(i)],
+                    "must be an array of 3 finite numbers");
+    // The norm of finite components can still overflow: compare the largest one first.
+    if (x.cwiseAbs().maxCoeff() > max_norm || x.norm() > max_norm)
+      fail(key, *v, "its length must be at most " + Json(max_norm).dump());
   }
   (*resolved_)[key] = {x.x(), x.y(), x.z()};
   return x;
@@ -129,10 +165,7 @@ std::array<double, 2> Reader::pair(const std::string& key, const std::array<doub
   if (v) {
     if (!v->is_array() || v->size() != 2) fail(key, *v, "must be an array of 2 numbers");
     for (std::size_t i = 0; i < 2; ++i) {
-      const Json& c = (*v)[i];
-      if (!c.is_number() || !std::isfinite(c.get<double>()))
-        fail(key, *v, "must be an array of 2 finite numbers");
-      x[i] = c.get<double>();
+      x[i] = finite(key, *v, (*v)[i], "must be an array of 2 finite numbers");
       if (x[i] < min || x[i] > max) fail(key, *v, range_text(min, max));
     }
   }

@@ -33,7 +33,8 @@ class SceneError : public std::runtime_error {
   std::string key_, value_, reason_;
 };
 
-/// A short printable form of a JSON value for error messages.
+/// A short printable form of a JSON value for error messages: at most 60 characters, and
+/// nesting below 8 levels shown as [...] or {...}, so any input prints in bounded time and stack.
 std::string show(const Json& value);
 
 /// Strict reader of one JSON object. `resolved` receives every value read (defaults included).
@@ -51,7 +52,9 @@ class Reader {
   bool boolean(const std::string& key, bool fallback);
   std::string text(const std::string& key, const std::string& fallback,
                    std::initializer_list<const char*> allowed = {});
-  Eigen::Vector3d vec3(const std::string& key, const Eigen::Vector3d& fallback);
+  /// An array of 3 finite numbers whose length is at most `max_norm`.
+  Eigen::Vector3d vec3(const std::string& key, const Eigen::Vector3d& fallback,
+                       double max_norm = kInf);
   /// An array of exactly two numbers, each in [min, max].
   std::array<double, 2> pair(const std::string& key, const std::array<double, 2>& fallback,
                              double min = -kInf, double max = kInf);
@@ -86,6 +89,9 @@ class Reader {
 
  private:
   void mark(const std::string& key) { used_.insert(key); }
+  /// The one finiteness check of every number read: `c` is `value` or one of its elements.
+  double finite(const std::string& key, const Json& value, const Json& c,
+                const std::string& reason) const;
   const Json* get(const std::string& key);
 
   const Json* object_;

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 
 #include "conform/bullet/plugin.hpp"
 #include "conform/io/import.hpp"
@@ -88,6 +89,24 @@ TEST(PluginSkinnedBody, ValidatesWorldAndInput) {
   EXPECT_EQ(body.piece_count(), 1);
   EXPECT_EQ(w.world.getSoftBodyArray().size(), 1);
   plugin.remove_skinned_body(body);
+  EXPECT_EQ(w.world.getSoftBodyArray().size(), 0);
+}
+
+// A triangle that repeats a vertex (assimp makes them from coincident corners) overflowed a
+// heap buffer in Bullet's face set-up; it is refused, naming the face, before Bullet sees it.
+TEST(PluginSkinnedBody, RefusesAFaceThatRepeatsAVertex) {
+  SoftWorld w;
+  bullet::Plugin plugin(w.world);
+  const auto arm = mesh::make_arm({.segments = 8, .rings = 10});
+  auto bad = arm.mesh;
+  bad.faces[7][2] = bad.faces[7][0];
+  try {
+    plugin.add_skinned_body(bad, arm.skeleton);
+    ADD_FAILURE() << "a face repeating a vertex was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("face 7 repeats vertex"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(plugin.skinned_body_count(), 0u);
   EXPECT_EQ(w.world.getSoftBodyArray().size(), 0);
 }
 

@@ -19,9 +19,10 @@ expect_error() {  # expect_error <stderr pattern> <args...>
   local pattern="$1"; shift
   local out="$tmp/bad"
   rm -rf "$out"
-  if "$conform" run "$@" --out "$out" > "$tmp/stdout" 2> "$tmp/stderr"; then
-    fail "run $* should fail"
-  fi
+  local rc=0
+  "$conform" run "$@" --out "$out" > "$tmp/stdout" 2> "$tmp/stderr" || rc=$?
+  [[ $rc -ne 0 ]] || fail "run $* should fail"
+  [[ $rc -lt 128 ]] || fail "run $* died of a signal (rc $rc) instead of an error"
   grep -q -- "$pattern" "$tmp/stderr" || { cat "$tmp/stderr" >&2; fail "run $*: no '$pattern' in the error"; }
   [[ ! -e "$out" ]] || fail "run $* wrote $out despite the error"
 }
@@ -38,6 +39,17 @@ printf '{ "scene": "arm-track", ' > "$tmp/broken.json"
 expect_error "not valid JSON" "$tmp/broken.json"
 printf '{ "scene": "arm-track", "seed": "seven" }' > "$tmp/badseed.json"
 expect_error "key 'seed', value \"seven\": must be an integer" "$tmp/badseed.json"
+# A value nested 100,000 deep: printing it for the error overflowed the stack (rc 139).
+python3 -c 'print("{\"scene\": \"arm-track\", \"seed\": " + "[" * 100000 + "]" * 100000 + "}")' \
+  > "$tmp/deep.json"
+expect_error "key 'seed', value \[\[\[\[\[\[\[\[\[...\]\]\]\]\]\]\]\]\]: must be an integer" "$tmp/deep.json"
+
+# 2^32 steps (42949.67296 s / 1e-5 s) wrapped to a 1-step run that exited 0.
+expect_error "key 'duration', value 42949.67296: with physics.dt = 1e-05 gives 4294967296 steps, more than the limit of 100000000" \
+  arm-track --set duration=42949.67296 --set physics.dt=1e-5
+# A finite but huge gravity made the results non-finite, with exit 0.
+expect_error "key 'physics.gravity', value \[0,-1e+300,0\]: its length must be at most 1000" \
+  arm-track --set 'physics.gravity=[0,-1e300,0]'
 
 # A short run from a scene file: every output, and the same numbers twice.
 cp "$tmp/arm.json" "$tmp/my-arm.json"

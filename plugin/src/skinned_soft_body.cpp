@@ -40,6 +40,15 @@ void validate(const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton) {
         throw std::invalid_argument("SkinnedSoftBody: face " + std::to_string(f) + " has vertex " +
                                     std::to_string(v) + ", out of range [0, " + std::to_string(n) +
                                     ")");
+  // Refused, not dropped: dropping would renumber the faces after it, so the caller's face
+  // ids would no longer name the body's faces (the importer is where such faces are dropped).
+  for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+    const auto& t = mesh.faces[f];
+    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0])
+      throw std::invalid_argument("SkinnedSoftBody: face " + std::to_string(f) +
+                                  " repeats vertex " + std::to_string(t[1] == t[2] ? t[1] : t[0]) +
+                                  " (a triangle needs 3 distinct vertices)");
+  }
   for (std::int32_t v = 0; v < n; ++v)
     for (int k = 0; k < mesh::kMaxInfluences; ++k)
       if (mesh.weights(k, v) != 0 &&

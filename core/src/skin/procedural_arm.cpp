@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace conform::mesh {
@@ -209,12 +210,20 @@ Arm make_arm(const ArmOptions& o) {
     throw std::invalid_argument("make_arm: lengths and blend widths must be positive");
   if (o.segments <= 0 && o.resolution < 1)
     throw std::invalid_argument("make_arm: resolution must be at least 1");
+  if (o.segments <= 0 && o.resolution > kMaxArmResolution)
+    throw std::invalid_argument("make_arm: resolution " + std::to_string(o.resolution) +
+                                " is more than the limit of " + std::to_string(kMaxArmResolution) +
+                                " (" + std::to_string(kMaxArmVertices) + " vertices)");
   const int segments = o.segments > 0 ? o.segments : 32 * o.resolution;
   const int rings = o.rings > 0 ? o.rings : 80 * o.resolution;
   if (segments < 3 || rings < 2)
     throw std::invalid_argument("make_arm: need at least 3 segments and 2 rings");
   const long long vcount = static_cast<long long>(rings) * segments + 2;
-  if (vcount > (1ll << 30)) throw std::invalid_argument("make_arm: resolution too large");
+  if (vcount > kMaxArmVertices)
+    throw std::invalid_argument("make_arm: " + std::to_string(vcount) +
+                                " vertices is more than the limit of " +
+                                std::to_string(kMaxArmVertices) + " (that of resolution " +
+                                std::to_string(kMaxArmResolution) + ")");
 
   const double scale = (o.upper_arm + o.forearm) / 0.55;  // 1 for the default arm
   const Profile p{o.upper_arm, o.upper_arm + o.forearm, o.upper_arm + o.forearm + o.hand,

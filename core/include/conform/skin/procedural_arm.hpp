@@ -49,7 +49,14 @@ struct Arm {
 /// Joint names of the arm's skeleton, in order.
 inline constexpr const char* kArmJointNames[3] = {"shoulder", "elbow", "wrist"};
 
-/// Builds the arm. Throws std::invalid_argument for non-positive sizes or resolutions.
+/// The largest resolution make_arm builds: N = 32 is 2,621,442 vertices. The surface grows as
+/// N², and arm:50 already peaked at 4.2 GB in `conform`; arm:200 would need tens of GB.
+inline constexpr int kMaxArmResolution = 32;
+/// The most vertices make_arm builds (those of N = kMaxArmResolution), explicit counts too.
+inline constexpr long long kMaxArmVertices = 80LL * kMaxArmResolution * 32 * kMaxArmResolution + 2;
+
+/// Builds the arm. Throws std::invalid_argument for non-positive sizes or resolutions and for
+/// more than kMaxArmResolution / kMaxArmVertices.
 Arm make_arm(const ArmOptions& options = {});
 /// Shorthand for make_arm({.resolution = resolution}).
 Arm make_arm(int resolution);
