@@ -28,7 +28,6 @@ void assimp_read(benchmark::State& state, const std::string& file) {
 
 void weld(benchmark::State& state, const std::string& file) {
   conform::io::ImportOptions options;
-  options.weight_tolerance = 0.5;
   options.weld = false;
   const conform::io::SkinnedModel split = conform::io::import_model(file, options);
   for (auto _ : state) {

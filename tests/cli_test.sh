@@ -25,5 +25,5 @@ expect_refused "must be a finite number, not nan" skin arm --time nan --out "$tm
 expect_refused "must be a finite number, not inf" ik --target 0.1 inf 0.2
 expect_refused "must be a finite number, not 1e400" info arm --weight-tolerance 1e400
 # arm:N grows as N^2 (arm:50 peaked at 4.2 GB): N is capped at 32, said in the error.
-expect_refused "resolution 33 is more than the limit of 32" info arm:33
+expect_refused "resolution must be an integer in .1, 32." info arm:33
 echo "cli_test: ok"

@@ -623,8 +623,9 @@ SkinnedModel load_model(const std::string& spec, const ImportOptions& options) {
     const char* b = spec.data() + 4;
     const char* e = spec.data() + spec.size();
     const auto r = std::from_chars(b, e, n);
-    if (r.ec != std::errc() || r.ptr != e || n < 1 || n > 200)
-      throw ImportError(spec, "the arm's resolution must be an integer in [1, 200]");
+    if (r.ec != std::errc() || r.ptr != e || n < 1 || n > mesh::kMaxArmResolution)
+      throw ImportError(spec, "the arm's resolution must be an integer in [1, " +
+                                  std::to_string(mesh::kMaxArmResolution) + "]");
     return arm_model(n);
   }
   return import_model(spec, options);
