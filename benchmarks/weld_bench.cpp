@@ -1,6 +1,9 @@
 // The cost of welding an imported model at its seams (io::weld_model, mesh/weld.hpp) against
 // assimp's own read of the same file with the same post-processing (io::import_flags()), in
 // the same run, on the rigged models of assimp-testmodels. Ratio: weld / assimp read.
+// Also the cost of isolating an import (ImportOptions::isolate: fork, import in the child,
+// the model back as bytes) against the same import in this process; wall time, because the
+// child's CPU time is not the process's. Ratio: isolated / in-process import.
 #include <benchmark/benchmark.h>
 
 #include <assimp/scene.h>
@@ -39,6 +42,12 @@ void weld(benchmark::State& state, const std::string& file) {
   state.counters["vertices"] = split.mesh.vertex_count();
 }
 
+void import(benchmark::State& state, const std::string& file, bool isolate) {
+  conform::io::ImportOptions options;
+  options.isolate = isolate;
+  for (auto _ : state) benchmark::DoNotOptimize(conform::io::import_model(file, options));
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -54,6 +63,16 @@ int main(int argc, char** argv) {
       weld(s, file);
     })->Unit(benchmark::kMillisecond);
     conform::bench::add_ratio(welding, read, "weld/assimp");
+    const std::string here = std::string("BM_Import/") + name,
+                      isolated = std::string("BM_ImportIsolated/") + name;
+    benchmark::RegisterBenchmark(here.c_str(), [=](benchmark::State& s) { import(s, file, false); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    benchmark::RegisterBenchmark(isolated.c_str(),
+                                 [=](benchmark::State& s) { import(s, file, true); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+    conform::bench::add_ratio(isolated, here, "isolated/in-process import", true);
   }
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;

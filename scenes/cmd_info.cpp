@@ -55,7 +55,7 @@ void register_info(CLI::App& app, Context& context) {
       "info", "Print the version and features, or, given MODEL, its meshes, bones and animations");
   auto model = std::make_shared<std::string>();
   auto options = std::make_shared<io::ImportOptions>();
-  options->crash_guard = true;  // a corrupt file must not kill the command
+  options->isolate = true;  // a corrupt file must not kill or corrupt the command
   cmd->add_option("MODEL", *model, "model file (any format assimp reads) or arm[:N]");
   add_strict_weights(cmd, options->strict_weights);
   cmd->callback([&context, model, options]() {

@@ -50,6 +50,7 @@ mesh::SkinnedMesh load(const Common& c, nlohmann::json& summary) {
   const auto t0 = Clock::now();
   io::ImportOptions options;
   options.strict_weights = c.strict_weights;
+  options.isolate = true;  // a corrupt file must not kill or corrupt the command
   io::SkinnedModel model = io::load_model(c.model, options);
   for (const auto& w : model.warnings)
     std::cerr << "warning: " << model.source << ": " << w << "\n";

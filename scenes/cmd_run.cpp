@@ -1,6 +1,7 @@
 // `conform run SCENE [--out DIR] [--steps N] [--set KEY=VALUE …]` and `conform scenes`.
 // SCENE is a built-in scene name or a JSON scene file. The scene is parsed completely before
-// anything is written, so a bad key or value leaves no folder behind.
+// anything is written, so a bad key or value leaves no folder behind; the results are written
+// atomically (output_folder.hpp): a failed run leaves the earlier results in --out untouched.
 #include <omp.h>
 
 #include <fstream>
@@ -9,6 +10,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "output_folder.hpp"
 #include "scene.hpp"
 
 namespace conform::cli {
@@ -58,8 +60,13 @@ int run_scene(const std::string& scene, const std::string& out_dir, int steps,
               << c.dt << " s, seed " << c.seed << "\n"
               << std::flush;
     if (c.threads > 0) omp_set_num_threads(c.threads);
-    scenes::RunOutput out(dir, c);
-    const scenes::Json metrics = prepared->run(out);
+    scenes::OutputFolder folder(dir);
+    scenes::Json metrics;
+    {
+      scenes::RunOutput out(folder.staging(), c);
+      metrics = prepared->run(out);
+    }
+    folder.commit();
     const scenes::Json summary =
         scenes::Json::parse(std::ifstream(dir / "summary.json"), nullptr, false);
     std::cout << "metrics:\n";

@@ -65,7 +65,7 @@ int run_skin(const SkinArgs& a, bool has_time, bool has_frames) {
   auto t0 = Clock::now();
   io::ImportOptions import_options;
   import_options.strict_weights = a.strict_weights;
-  import_options.crash_guard = true;  // a corrupt file must not kill the command
+  import_options.isolate = true;  // a corrupt file must not kill or corrupt the command
   io::SkinnedModel model = io::load_model(a.model, import_options);
   const double load_ms = ms_since(t0);
   for (const auto& w : model.warnings)

@@ -160,16 +160,40 @@ bool RunOutput::draw(const Plot& plot, std::string& problem) const {
                           " > " + quote(plot.name + ".log") + " 2>&1";
   const int rc = std::system(cmd.c_str());
   if (rc != 0) {
-    problem = "gnuplot failed (see " + (dir_ / (plot.name + ".log")).string() + ")";
+    problem = "gnuplot failed (see " + plot.name + ".log in the output folder)";
     return false;
   }
   fs::remove(dir_ / (plot.name + ".log"));
   return true;
 }
 
+namespace {
+
+// The key of the first NaN or infinite number in `value` ("" when all are finite). JSON has no
+// NaN: nlohmann would write it as null, and a summary would look like a success.
+std::string first_non_finite(const Json& value, const std::string& key) {
+  if (value.is_number_float() && !std::isfinite(value.get<double>()))
+    return key.empty() ? "(value)" : key;
+  if (value.is_object())
+    for (auto it = value.begin(); it != value.end(); ++it)
+      if (auto bad = first_non_finite(*it, key.empty() ? it.key() : key + "." + it.key());
+          !bad.empty())
+        return bad;
+  if (value.is_array())
+    for (std::size_t i = 0; i < value.size(); ++i)
+      if (auto bad = first_non_finite(value[i], key + "[" + std::to_string(i) + "]"); !bad.empty())
+        return bad;
+  return {};
+}
+
+}  // namespace
+
 fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int steps,
                            double simulated_seconds, double loop_seconds) {
   metrics_.reset();  // flush metrics.csv before gnuplot reads it
+  if (const std::string bad = first_non_finite(metrics, ""); !bad.empty())
+    throw std::runtime_error("metric " + bad +
+                             " is NaN or infinite: the simulation went non-finite");
   const double wall = std::chrono::duration<double>(Clock::now() - start_).count();
   Json plots = Json::object();
   if (common_.plots) {

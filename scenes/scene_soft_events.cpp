@@ -375,6 +375,7 @@ class Character final : public Scene {
     animation_ = model.text("animation", "0");
     units_ = model.number("units_per_metre", 1, 1e-6, 1e6);
     import_.strict_weights = model.boolean("strict_weights", false);
+    import_.isolate = true;  // a corrupt file must not kill or corrupt the run
     model.finish();
     bullet::Material d;
     // Real characters come at any scale (units_per_metre) and their animations stretch the

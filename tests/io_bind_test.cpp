@@ -4,9 +4,11 @@
 // the rest pose and at key times of every animation.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <tuple>
 
 #include "assimp_reference.hpp"
 #include "conform/io/import.hpp"
@@ -318,3 +320,97 @@ TEST(IoBind, InstancedMeshYieldsAllItsInstances) {
 }
 
 }  // namespace
+
+namespace {
+
+std::array<double, 9> coefficients(const skin::Versor& v) {
+  const auto& m = v.motor;
+  return {m.s, m.e12, m.e13, m.e23, m.e1inf, m.e2inf, m.e3inf, m.e123inf, v.scale};
+}
+
+// Field by field, bit for bit: the isolated import ran the same code in the child.
+void expect_same_model(const io::SkinnedModel& a, const io::SkinnedModel& b, const char* path) {
+  SCOPED_TRACE(path);
+  EXPECT_EQ(a.source, b.source);
+  const auto& m = a.mesh;
+  const auto& n = b.mesh;
+  EXPECT_EQ(m.rest, n.rest);
+  EXPECT_EQ(m.current, n.current);
+  EXPECT_EQ(m.faces, n.faces);
+  EXPECT_EQ(m.bones, n.bones);
+  EXPECT_EQ(m.weights, n.weights);
+  EXPECT_EQ(m.uvs, n.uvs);
+  EXPECT_EQ(m.normals, n.normals);
+  EXPECT_EQ(m.corner_uvs, n.corner_uvs);
+  EXPECT_EQ(m.corner_normals, n.corner_normals);
+  EXPECT_EQ(a.influences.offsets, b.influences.offsets);
+  EXPECT_EQ(a.influences.bones, b.influences.bones);
+  EXPECT_EQ(a.influences.weights, b.influences.weights);
+  ASSERT_EQ(a.skeleton.joint_count(), b.skeleton.joint_count());
+  for (std::size_t j = 0; j < a.skeleton.joints.size(); ++j) {
+    EXPECT_EQ(a.skeleton.joints[j].name, b.skeleton.joints[j].name);
+    EXPECT_EQ(a.skeleton.joints[j].parent, b.skeleton.joints[j].parent);
+    EXPECT_EQ(coefficients(a.skeleton.joints[j].rest), coefficients(b.skeleton.joints[j].rest));
+  }
+  ASSERT_EQ(a.skeleton.bone_count(), b.skeleton.bone_count());
+  for (std::size_t i = 0; i < a.skeleton.bones.size(); ++i) {
+    EXPECT_EQ(a.skeleton.bones[i].name, b.skeleton.bones[i].name);
+    EXPECT_EQ(a.skeleton.bones[i].joint, b.skeleton.bones[i].joint);
+    EXPECT_EQ(coefficients(a.skeleton.bones[i].offset), coefficients(b.skeleton.bones[i].offset));
+  }
+  ASSERT_EQ(a.animations.size(), b.animations.size());
+  for (std::size_t i = 0; i < a.animations.size(); ++i) {
+    const auto &x = a.animations[i], &y = b.animations[i];
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(x.duration_ticks, y.duration_ticks);
+    EXPECT_EQ(x.ticks_per_second, y.ticks_per_second);
+    ASSERT_EQ(x.channels.size(), y.channels.size());
+    for (std::size_t c = 0; c < x.channels.size(); ++c) {
+      const auto &p = x.channels[c], &q = y.channels[c];
+      EXPECT_EQ(p.joint, q.joint);
+      ASSERT_EQ(p.translation.size(), q.translation.size());
+      ASSERT_EQ(p.rotation.size(), q.rotation.size());
+      ASSERT_EQ(p.scale.size(), q.scale.size());
+      for (std::size_t k = 0; k < p.translation.size(); ++k) {
+        EXPECT_EQ(p.translation[k].time, q.translation[k].time);
+        EXPECT_EQ(p.translation[k].value, q.translation[k].value);
+      }
+      for (std::size_t k = 0; k < p.rotation.size(); ++k) {
+        EXPECT_EQ(p.rotation[k].time, q.rotation[k].time);
+        EXPECT_EQ(p.rotation[k].value.coeffs(), q.rotation[k].value.coeffs());
+      }
+      for (std::size_t k = 0; k < p.scale.size(); ++k) {
+        EXPECT_EQ(p.scale[k].time, q.scale[k].time);
+        EXPECT_EQ(p.scale[k].value, q.scale[k].value);
+      }
+    }
+  }
+  ASSERT_EQ(a.meshes.size(), b.meshes.size());
+  for (std::size_t i = 0; i < a.meshes.size(); ++i) {
+    const auto &x = a.meshes[i], &y = b.meshes[i];
+    EXPECT_EQ(x.name, y.name);
+    EXPECT_EQ(std::tie(x.first_vertex, x.vertex_count, x.first_face, x.face_count, x.joint, x.bones,
+                       x.source),
+              std::tie(y.first_vertex, y.vertex_count, y.first_face, y.face_count, y.joint, y.bones,
+                       y.source));
+  }
+  EXPECT_EQ(a.warnings, b.warnings);
+}
+
+}  // namespace
+
+// An isolated import (ImportOptions::isolate: the child imports, the caller decodes) gives the
+// same model as one in this process, on every rigged test model, welded (UV and normal corner
+// arrays) and not.
+TEST(IoBind, IsolatedImportIsTheSameModel) {
+  for (const char* path : kRiggedModels) {
+    const std::string file = kModels + "/" + path;
+    for (const bool weld : {true, false}) {
+      io::ImportOptions here;
+      here.weld = weld;
+      io::ImportOptions isolated = here;
+      isolated.isolate = true;
+      expect_same_model(io::import_model(file, here), io::import_model(file, isolated), path);
+    }
+  }
+}

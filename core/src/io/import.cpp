@@ -13,7 +13,8 @@
 #include <sstream>
 #include <unordered_map>
 
-#include "conform/io/crash_guard.hpp"
+#include "conform/io/isolate.hpp"
+#include "conform/io/model_wire.hpp"
 #include "conform/io/weld_model.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
@@ -64,11 +65,13 @@ struct Builder {
   ImportOptions options;
   SkinnedModel model{};
   std::unordered_map<std::string, std::int32_t> joint_by_name{};
+  std::unordered_map<const aiNode*, std::int32_t> joint_of_node{};
   std::vector<JointFrame> frames{};               // per joint
   std::vector<detail::MeshInstance> instances{};  // every (mesh, node) placement
   std::vector<Eigen::Matrix4d> bone_keys{};       // per bone, O K⁻¹, for de-duplication
   std::vector<std::string> approximated{};        // transforms that are not proper similarities
   WeightSums sums{};
+  std::size_t repeated_vertex_faces = 0;
 
   [[noreturn]] void fail(const std::string& problem) const { throw ImportError(file, problem); }
   void warn(const std::string& w) { model.warnings.push_back(w); }
@@ -101,12 +104,12 @@ struct Builder {
   // parent is the node's mParent when that was visited already: assimp's HL1 MDL loader
   // lists a bone chain as siblings whose mParent pointers hold the real chain (and the
   // offsets match that), e.g. MDL/MDL (HL1)/man.mdl.
-  void walk(const aiNode* node, std::int32_t parent) {
+  void add_joint(const aiNode* node, std::int32_t parent) {
     const auto index = static_cast<std::int32_t>(model.skeleton.joints.size());
     if (node->mParent && parent >= 0 &&
         frames[static_cast<std::size_t>(parent)].node != node->mParent)
-      for (std::int32_t j = 0; j < index; ++j)
-        if (frames[static_cast<std::size_t>(j)].node == node->mParent) parent = j;
+      if (const auto it = joint_of_node.find(node->mParent); it != joint_of_node.end())
+        parent = it->second;
     const Eigen::Matrix4d local = to_eigen(node->mTransformation);
     JointFrame f;
     f.node = node;
@@ -131,9 +134,26 @@ struct Builder {
     model.skeleton.joints.push_back(std::move(j));
     frames.push_back(f);
     joint_by_name.emplace(node->mName.C_Str(), index);  // the first node of a name wins
+    joint_of_node.emplace(node, index);
     for (unsigned i = 0; i < node->mNumMeshes; ++i)
       if (node->mMeshes[i] < scene->mNumMeshes) instances.push_back({node->mMeshes[i], node});
-    for (unsigned c = 0; c < node->mNumChildren; ++c) walk(node->mChildren[c], index);
+  }
+
+  // Depth-first, parents first, children in file order, with an explicit stack: a file sets
+  // the depth (a 20,000-node chain must not overflow the call stack). A node reached twice (a
+  // cycle, or a node shared by two parents) is refused.
+  void walk(const aiNode* root) {
+    std::vector<std::pair<const aiNode*, std::int32_t>> stack{{root, -1}};
+    while (!stack.empty()) {
+      const auto [node, parent] = stack.back();
+      stack.pop_back();
+      if (!node) fail("the node hierarchy has a null child");
+      if (joint_of_node.count(node))
+        fail("node '" + node_name(node) + "' appears twice in the node hierarchy (a cycle?)");
+      const auto index = static_cast<std::int32_t>(model.skeleton.joints.size());
+      add_joint(node, parent);
+      for (unsigned c = node->mNumChildren; c-- > 0;) stack.emplace_back(node->mChildren[c], index);
+    }
   }
 
   // Instances in mesh order (a mesh's instances in node order); a mesh no node places gets one
@@ -155,9 +175,8 @@ struct Builder {
   }
 
   std::int32_t joint_of(const aiNode* node) const {
-    for (std::size_t j = 0; j < frames.size(); ++j)
-      if (frames[j].node == node) return static_cast<std::int32_t>(j);
-    return 0;
+    const auto it = joint_of_node.find(node);
+    return it == joint_of_node.end() ? 0 : it->second;
   }
 
   // A bone without a node of its name (e.g. X/anim_test.x's joint3, joint4) gets a root
@@ -295,6 +314,9 @@ struct Builder {
       base += info.vertex_count;
     }
     if (skipped) warn(std::to_string(skipped) + " point or line primitives ignored");
+    if (repeated_vertex_faces)
+      warn(std::to_string(repeated_vertex_faces) +
+           " triangles that repeat a vertex (zero area) dropped");
     if (mesh.faces.empty()) fail("contains no triangles");
     if (sums.off)
       warn("the bone weights of " + std::to_string(sums.off) + " vertices do not sum to 1 (" +
@@ -324,11 +346,18 @@ struct Builder {
         const aiVector3D& n = am->mNormals[v];
         const Eigen::Vector3d baked = normal_map * Eigen::Vector3d(n.x, n.y, n.z);
         const double length = baked.norm();
-        mesh.normals.col(col) = length > 0 ? Eigen::Vector3d(baked / length) : baked;
+        // A degenerate corner's normal (assimp's NaN) becomes 0: "no normal", not NaN.
+        mesh.normals.col(col) = length > 0 && std::isfinite(length)
+                                    ? Eigen::Vector3d(baked / length)
+                                    : Eigen::Vector3d::Zero();
       }
       if (all_uvs) {
         const aiVector3D& uv = am->mTextureCoords[0][v];
-        mesh.uvs.col(col) = Eigen::Vector2d(uv.x, uv.y);
+        const Eigen::Vector2d st(uv.x, uv.y);
+        if (!st.allFinite())
+          fail("mesh '" + info.name + "' vertex " + std::to_string(v) +
+               " has a NaN or infinite UV");
+        mesh.uvs.col(col) = st;
       }
     }
   }
@@ -350,6 +379,10 @@ struct Builder {
           fail("mesh '" + info.name + "' face " + std::to_string(f) + " refers to vertex " +
                std::to_string(face.mIndices[k]) + " of " + std::to_string(am->mNumVertices));
         tri[static_cast<std::size_t>(k)] = base + static_cast<std::int32_t>(face.mIndices[k]);
+      }
+      if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+        ++repeated_vertex_faces;  // assimp makes these from coincident corners (.dxf)
+        continue;
       }
       if (mirrored) std::swap(tri[1], tri[2]);
       mesh.faces.push_back(tri);
@@ -533,16 +566,35 @@ void pose_current(SkinnedModel& m) {
   s.write(m.mesh.current);
 }
 
-// Reads the file in a forked child first; empty when the child did not crash (it may still have
-// failed: the real read reports that), else why it crashed.
-std::string crashes_assimp(const std::string& file) {
-  const std::string signal = crash_in_child([&] {
-    Assimp::Importer importer;
-    importer.ReadFile(file, import_flags());
-  });
-  if (signal.empty()) return {};
-  return "assimp crashed reading it (" + signal +
-         "); the file is corrupt (e.g. bone or vertex indices out of range)";
+// The import error for an isolated import that did not end with a model.
+ImportError isolation_error(const std::string& file, const Isolated& r,
+                            const IsolationLimits& limits) {
+  using S = Isolated::Status;
+  std::ostringstream why;
+  switch (r.status) {
+    case S::failed:  // the child's ImportError ("file: problem") or another exception's what()
+      if (r.message.find("bad_alloc") == std::string::npos)
+        return ImportError(file, r.message.rfind(file + ": ", 0) == 0
+                                     ? r.message.substr(file.size() + 2)
+                                     : r.message);
+      [[fallthrough]];  // assimp caught std::bad_alloc and reports it as its error
+    case S::out_of_memory:
+      why << "reading it ran out of memory (the import's cap is " << limits.memory_bytes / 1048576.0
+          << " MiB: ImportOptions::isolation.memory_bytes); the file is corrupt or too large";
+      break;
+    case S::timed_out:
+      why << "reading it did not finish within " << limits.seconds
+          << " s (ImportOptions::isolation.seconds); the file is corrupt or too large";
+      break;
+    case S::crashed:
+      why << "assimp crashed reading it (" << r.message
+          << "); the file is corrupt (e.g. bone or vertex indices out of range) or its node "
+             "hierarchy too deep";
+      break;
+    default:
+      why << "could not start the isolated import (" << r.message << ")";
+  }
+  return ImportError(file, why.str());
 }
 
 }  // namespace
@@ -562,19 +614,11 @@ unsigned import_flags() {
   return aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_ValidateDataStructure;
 }
 
-SkinnedModel import_model(const std::filesystem::path& path, const ImportOptions& options) {
-  const std::string file = path.string();
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw ImportError(file, "no such file");
-  if (std::filesystem::is_directory(path, ec)) throw ImportError(file, "is a directory");
-  if (!std::ifstream(path, std::ios::binary))
-    throw ImportError(file, "cannot be opened for reading");
+namespace {
+
+// The import itself, in this process.
+SkinnedModel import_here(const std::string& file, const ImportOptions& options) {
   Assimp::Importer importer;
-  const std::string ext = path.extension().string();
-  if (ext.empty() || !importer.IsExtensionSupported(ext))
-    throw ImportError(file, "unsupported format '" + ext + "' (assimp has no importer for it)");
-  if (options.crash_guard)
-    if (const auto why = crashes_assimp(file); !why.empty()) throw ImportError(file, why);
   const aiScene* scene = importer.ReadFile(file, import_flags());
   if (!scene) {
     std::string why = importer.GetErrorString();
@@ -587,7 +631,7 @@ SkinnedModel import_model(const std::filesystem::path& path, const ImportOptions
 
   Builder b{file, scene, options};
   b.model.source = file;
-  b.walk(scene->mRootNode, -1);
+  b.walk(scene->mRootNode);
   b.meshes();
   b.animations();
   if (const auto e = b.model.skeleton.validate(); !e.empty()) b.fail(e);
@@ -598,6 +642,36 @@ SkinnedModel import_model(const std::filesystem::path& path, const ImportOptions
   if (options.weld) weld_model(b.model, options.weld_options);
   pose_current(b.model);
   return std::move(b.model);
+}
+
+// The import in a child process (isolate.hpp); this process only decodes the child's model.
+SkinnedModel import_isolated(const std::string& file, const ImportOptions& options) {
+  const Isolated r =
+      run_isolated([&] { return encode_model(import_here(file, options)); }, options.isolation);
+  if (r.status != Isolated::Status::ok) throw isolation_error(file, r, options.isolation);
+  try {
+    return decode_model(r.result);
+  } catch (const std::exception& e) {
+    throw ImportError(file,
+                      std::string("the isolated import sent a bad result (") + e.what() + ")");
+  }
+}
+
+}  // namespace
+
+SkinnedModel import_model(const std::filesystem::path& path, const ImportOptions& options) {
+  const std::string file = path.string();
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw ImportError(file, "no such file");
+  if (std::filesystem::is_directory(path, ec)) throw ImportError(file, "is a directory");
+  if (!std::filesystem::is_regular_file(path, ec))  // a FIFO would block the open below
+    throw ImportError(file, "is not a regular file (a FIFO, socket or device?)");
+  if (!std::ifstream(path, std::ios::binary))
+    throw ImportError(file, "cannot be opened for reading");
+  const std::string ext = path.extension().string();
+  if (ext.empty() || !Assimp::Importer().IsExtensionSupported(ext))
+    throw ImportError(file, "unsupported format '" + ext + "' (assimp has no importer for it)");
+  return options.isolate ? import_isolated(file, options) : import_here(file, options);
 }
 
 SkinnedModel arm_model(int resolution) {

@@ -41,6 +41,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "conform/io/isolation_limits.hpp"
 #include "conform/io/model.hpp"
 #include "conform/mesh/weld.hpp"
 
@@ -62,12 +63,16 @@ struct ImportOptions {
   /// with a summary warning (the command line's --strict-weights, scene files'
   /// model.strict_weights).
   bool strict_weights = false;
-  /// Read the file once in a forked child process first (POSIX), so that a file on which
-  /// assimp itself crashes (assimp 5.2 segfaults or aborts on out-of-range bone or vertex
-  /// indices in .x and .dae files) gives an ImportError instead of killing the caller. Costs
-  /// a second read. Off by default: forking a multithreaded host is only safe when no other
-  /// thread holds a lock the child needs; the `conform` command turns it on.
-  bool crash_guard = false;
+  /// Import in a forked child process (POSIX) with the caps of `isolation`, so that a file on
+  /// which assimp crashes, hangs or allocates without bound (assimp 5.2 segfaults, aborts or
+  /// corrupts its heap on out-of-range bone or vertex indices in .x, .dae and .md5mesh files)
+  /// gives an ImportError saying so instead of killing or corrupting the caller: the child does
+  /// the whole import and sends the model back as bytes; assimp never runs in the caller. The
+  /// child dies with the calling thread. Off by default for library users: forking a
+  /// multithreaded host is only safe when no other thread holds a lock the child needs; every
+  /// `conform` command turns it on.
+  bool isolate = false;
+  IsolationLimits isolation;
   /// Weld each mesh's vertices at one position, keeping UVs and normals per face corner
   /// (io/weld_model.hpp, mesh/weld.hpp: the tolerance is relative to the bounding-box diagonal;
   /// vertices whose weights differ stay apart).
