@@ -1,6 +1,9 @@
-// `conform cut`, `conform tear` and `conform drill`: load a model (a file or arm[:N]), apply
-// the operation to its current (bind-pose, world-space) positions, and write every resulting
-// piece as PLY (or OBJ) into DIR with a summary.json of counts and timings.
+// `conform cut`, `conform tear` and `conform drill`: load a model (a file or arm[:N]), pose it
+// (the bind pose, or --animation A --time T), apply the operation to its current (posed,
+// world-space) positions, and write every resulting piece as PLY (or OBJ) into DIR with a
+// summary.json of counts and timings. A posed edit also writes the pieces at rest into DIR/rest/
+// (new vertices get the same combination of rest positions as of posed ones). DIR is written
+// atomically (output_folder.hpp): it holds exactly this run's files, or the earlier ones.
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +21,8 @@
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/tear.hpp"
+#include "model_pose.hpp"
+#include "output_folder.hpp"
 
 namespace conform::cli {
 
@@ -35,6 +40,9 @@ struct Common {
   std::string out;
   std::string format = "ply";
   bool strict_weights = false;
+  std::string animation = "0";
+  double time = 0;
+  bool posed = false;  // --time given
 };
 
 void add_common(CLI::App* cmd, Common& c) {
@@ -43,6 +51,38 @@ void add_common(CLI::App* cmd, Common& c) {
   cmd->add_option("--format", c.format, "ply (binary), ply-ascii or obj")
       ->check(CLI::IsMember({"ply", "ply-ascii", "obj"}));
   add_strict_weights(cmd, c.strict_weights);
+  cmd->add_option(
+      "--animation", c.animation,
+      "with --time: the animation to pose the model with, by name or index (default 0)");
+  cmd->add_option_function<double>(
+         "--time",
+         [&c](double t) {
+           c.time = t;
+           c.posed = true;
+         },
+         "edit the model posed at this time of the animation (s; default: the bind pose)")
+      ->check(CLI::NonNegativeNumber);
+}
+
+// Vertices that the faces `faces` of `m` use.
+std::int32_t used_vertex_count(const mesh::SkinnedMesh& m, const std::vector<std::int32_t>& faces) {
+  std::vector<char> used(static_cast<std::size_t>(m.vertex_count()), 0);
+  std::int32_t n = 0;
+  for (auto f : faces)
+    for (auto v : m.faces[static_cast<std::size_t>(f)])
+      n += used[static_cast<std::size_t>(v)] ? 0 : (used[static_cast<std::size_t>(v)] = 1);
+  return n;
+}
+
+// The area of `faces` at the rest positions.
+double rest_area(const mesh::SkinnedMesh& m, const std::vector<std::int32_t>& faces) {
+  double area = 0;
+  for (auto f : faces) {
+    const auto& t = m.faces[static_cast<std::size_t>(f)];
+    area += 0.5 *
+            (m.rest.col(t[1]) - m.rest.col(t[0])).cross(m.rest.col(t[2]) - m.rest.col(t[0])).norm();
+  }
+  return area;
 }
 
 // Loads the model; returns its mesh (current = the bind pose in world space).
@@ -57,17 +97,18 @@ mesh::SkinnedMesh load(const Common& c, nlohmann::json& summary) {
   summary["model"] = model.source;
   summary["warnings"] = model.warnings;
   summary["input"] = {{"vertices", model.mesh.vertex_count()}, {"faces", model.mesh.face_count()}};
+  if (c.posed) {
+    pose_model(model, c.animation, c.time);
+    summary["pose"] = {{"animation", find_animation_or_throw(model, c.animation).name},
+                       {"time_s", c.time}};
+  }
   summary["timing_ms"]["load"] = ms_since(t0);
   return std::move(model.mesh);
 }
 
-// Writes every piece and summary.json; only these files are written into the directory.
-void write_pieces(const Common& c, const mesh::SkinnedMesh& m, nlohmann::json& summary) {
-  const auto t0 = Clock::now();
-  const fs::path dir(c.out);
-  fs::create_directories(dir);
-  const io::MeshFormat format = io::parse_mesh_format(c.format);
-  const mesh::Pieces pieces = mesh::label_pieces(m);
+// Every piece of `m` into `dir`, at its current or rest positions; the pieces' list.
+nlohmann::json write_piece_files(const fs::path& dir, const mesh::SkinnedMesh& m,
+                                 const mesh::Pieces& pieces, io::MeshFormat format, bool rest) {
   std::vector<std::vector<std::int32_t>> faces(static_cast<std::size_t>(pieces.count));
   for (std::size_t f = 0; f < pieces.face_piece.size(); ++f)
     faces[static_cast<std::size_t>(pieces.face_piece[f])].push_back(static_cast<std::int32_t>(f));
@@ -76,28 +117,46 @@ void write_pieces(const Common& c, const mesh::SkinnedMesh& m, nlohmann::json& s
     char name[32];
     std::snprintf(name, sizeof name, "piece_%03d%s", p, io::mesh_format_extension(format));
     const auto& pf = faces[static_cast<std::size_t>(p)];
-    io::write_mesh(dir / name, m, {format, false, true}, pf);
-    std::vector<char> used(static_cast<std::size_t>(m.vertex_count()), 0);
-    std::int32_t nv = 0;
-    for (auto f : pf)
-      for (auto v : m.faces[static_cast<std::size_t>(f)])
-        nv += used[static_cast<std::size_t>(v)] ? 0 : (used[static_cast<std::size_t>(v)] = 1);
+    io::write_mesh(dir / name, m, {format, rest, true}, pf);
     list.push_back({{"file", name},
-                    {"vertices", nv},
+                    {"vertices", used_vertex_count(m, pf)},
                     {"faces", pf.size()},
-                    {"area", mesh::surface_area(m, pf)}});
+                    {"area", rest ? rest_area(m, pf) : mesh::surface_area(m, pf)}});
   }
+  return list;
+}
+
+// Writes every piece and summary.json (and the rest pieces of a posed edit): only these files
+// are in the directory afterwards.
+void write_pieces(const Common& c, const mesh::SkinnedMesh& m, nlohmann::json& summary) {
+  const auto t0 = Clock::now();
+  scenes::OutputFolder folder{fs::path(c.out)};
+  const io::MeshFormat format = io::parse_mesh_format(c.format);
+  const mesh::Pieces pieces = mesh::label_pieces(m);
+  const nlohmann::json list = write_piece_files(folder.staging(), m, pieces, format, false);
+  if (c.posed) {
+    fs::create_directories(folder.staging() / "rest");
+    summary["rest_pieces"] = write_piece_files(folder.staging() / "rest", m, pieces, format, true);
+  }
+  std::vector<std::int32_t> all(static_cast<std::size_t>(m.face_count()));
+  for (std::size_t f = 0; f < all.size(); ++f) all[f] = static_cast<std::int32_t>(f);
+  const std::int32_t used = used_vertex_count(m, all);
   const mesh::MeshReport report = mesh::check_mesh(m);
-  summary["output"] = {{"vertices", m.vertex_count()}, {"faces", m.face_count()},
-                       {"pieces", pieces.count},       {"piece_files", list},
-                       {"closed", report.closed()},    {"manifold", report.manifold()},
+  // Counts are of what the files hold: vertices no face uses (left by an edit) are not written.
+  summary["output"] = {{"vertices", used},
+                       {"faces", m.face_count()},
+                       {"unused_vertices", m.vertex_count() - used},
+                       {"pieces", pieces.count},
+                       {"piece_files", list},
+                       {"closed", report.closed()},
+                       {"manifold", report.manifold()},
                        {"oriented", report.oriented()}};
   summary["timing_ms"]["write"] = ms_since(t0);
-  std::ofstream os(dir / "summary.json.tmp");
+  std::ofstream os(folder.staging() / "summary.json");
   os << summary.dump(2) << "\n";
   os.close();
-  if (!os) throw std::runtime_error("cannot write " + (dir / "summary.json").string());
-  fs::rename(dir / "summary.json.tmp", dir / "summary.json");
+  if (!os) throw std::runtime_error("cannot write " + (fs::path(c.out) / "summary.json").string());
+  folder.commit();
 }
 
 template <class Fn>

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "model_pose.hpp"
 #include "conform/io/import.hpp"
 #include "conform/io/mesh_export.hpp"
 #include "conform/skin/skinner.hpp"
@@ -73,12 +74,7 @@ int run_skin(const SkinArgs& a, bool has_time, bool has_frames) {
 
   const skin::Animation* anim = nullptr;
   if (!a.animation.empty()) {
-    const int i = model.find_animation(a.animation);
-    if (i < 0)
-      throw std::invalid_argument(model.source + ": no animation named or numbered '" +
-                                  a.animation + "' (" + std::to_string(model.animations.size()) +
-                                  " animations)");
-    anim = &model.animations[static_cast<std::size_t>(i)];
+    anim = &find_animation_or_throw(model, a.animation);
   } else if (!model.animations.empty()) {
     anim = &model.animations.front();
   }

@@ -8,6 +8,15 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <vector>
+
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <Eigen/Geometry>
+#include <assimp/Importer.hpp>
+
+#include "conform/io/import.hpp"
 
 namespace fs = std::filesystem;
 
@@ -122,5 +131,95 @@ TEST_F(MeshCli, ErrorsExitNonZero) {
   // A plane that misses is a documented no-op: the whole model is written as one piece.
   EXPECT_EQ(run("cut arm --plane 0 0 1 5 --out " + d.string()), 0);
   EXPECT_EQ(summary(d)["status"], "missed");
+  fs::remove_all(d);
+}
+
+namespace {
+
+// The vertices of a PLY or OBJ file as assimp reads them (the file's own numbering is lost; only
+// positions matter here), and its area.
+struct ReadMesh {
+  std::vector<Eigen::Vector3d> points;
+  double area = 0;
+};
+
+ReadMesh read_mesh(const fs::path& file) {
+  Assimp::Importer importer;
+  const aiScene* scene = importer.ReadFile(file.string(), aiProcess_Triangulate);
+  ReadMesh out;
+  if (!scene) {
+    ADD_FAILURE() << file << ": " << importer.GetErrorString();
+    return out;
+  }
+  for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
+    const aiMesh* am = scene->mMeshes[m];
+    const auto at = [&](unsigned i) {
+      const aiVector3D& p = am->mVertices[i];
+      return Eigen::Vector3d(p.x, p.y, p.z);
+    };
+    for (unsigned v = 0; v < am->mNumVertices; ++v) out.points.push_back(at(v));
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+      const aiFace& face = am->mFaces[f];
+      if (face.mNumIndices != 3) continue;
+      out.area += 0.5 * (at(face.mIndices[1]) - at(face.mIndices[0]))
+                            .cross(at(face.mIndices[2]) - at(face.mIndices[0]))
+                            .norm();
+    }
+  }
+  return out;
+}
+
+// −1, 0 or +1: which side of n·x = d all of `points` are on (0: on both sides).
+int side(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& n, double d) {
+  bool below = false, above = false;
+  for (const auto& p : points) {
+    below = below || n.dot(p) - d < -1e-6;
+    above = above || n.dot(p) - d > 1e-6;
+  }
+  return below == above ? 0 : (above ? 1 : -1);
+}
+
+}  // namespace
+
+// A posed edit (issue 13): the cut is made on the model posed at --time, so the posed pieces lie
+// on the two sides of the plane and add up to the posed model's area (written by `conform skin`
+// at the same time); the rest pieces add up to the model's area at rest, and at rest the plane
+// no longer separates them.
+TEST_F(MeshCli, PosedCutCutsThePosedModelAndWritesTheRestPieces) {
+  const std::string model = "/usr/share/assimp/models/glTF2/simple_skin/simple_skin.gltf";
+  const fs::path d = fresh_dir("posed");
+  const Eigen::Vector3d n(0, 1, 0);
+  const double at = 1.0;
+  ASSERT_EQ(run("cut " + model + " --animation 0 --time 1.0 --plane 0 1 0 1.0 --out " + d.string()),
+            0);
+  const auto s = summary(d);
+  EXPECT_EQ(s["pose"]["time_s"], 1.0);
+  ASSERT_EQ(s["output"]["pieces"], 2);
+  ASSERT_EQ(s["rest_pieces"].size(), 2u);
+  double posed_area = 0, rest_area = 0;
+  std::vector<int> posed_sides, rest_sides;
+  for (const char* piece : {"piece_000.ply", "piece_001.ply"}) {
+    const ReadMesh posed = read_mesh(d / piece), rest = read_mesh(d / "rest" / piece);
+    EXPECT_EQ(posed.points.size(), rest.points.size()) << piece;
+    posed_area += posed.area;
+    rest_area += rest.area;
+    posed_sides.push_back(side(posed.points, n, at));
+    rest_sides.push_back(side(rest.points, n, at));
+  }
+  EXPECT_EQ(posed_sides[0] * posed_sides[1], -1) << "the posed pieces are not split by the plane";
+  EXPECT_TRUE(rest_sides[0] == 0 || rest_sides[1] == 0) << "at rest the plane still separates";
+  ASSERT_EQ(run("skin " + model + " --animation 0 --time 1.0 --out " + (d / "posed.ply").string()),
+            0);
+  EXPECT_NEAR(posed_area, read_mesh(d / "posed.ply").area, 1e-5);
+  const auto m = conform::io::import_model(model);
+  double model_rest_area = 0;
+  for (const auto& t : m.mesh.faces)
+    model_rest_area += 0.5 * (m.mesh.rest.col(t[1]) - m.mesh.rest.col(t[0]))
+                                 .cross(m.mesh.rest.col(t[2]) - m.mesh.rest.col(t[0]))
+                                 .norm();
+  EXPECT_NEAR(rest_area, model_rest_area, 1e-5);
+  // An unknown animation is refused, naming it.
+  EXPECT_NE(run("cut " + model + " --animation walk --time 1 --plane 0 1 0 1 --out " + d.string()),
+            0);
   fs::remove_all(d);
 }
