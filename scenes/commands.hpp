@@ -19,6 +19,7 @@ void register_skin(CLI::App& app, Context& context);      // cmd_skin.cpp   (iss
 void register_mesh_ops(CLI::App& app, Context& context);  // cmd_mesh_ops.cpp (issue 5)
 void register_run(CLI::App& app, Context& context);       // cmd_run.cpp    (issue 7)
 void register_scenes(CLI::App& app, Context& context);    // cmd_run.cpp    (issue 7)
+void register_sweep(CLI::App& app, Context& context);     // cmd_sweep.cpp  (issue 17)
 
 /// --strict-weights: the one name of io::ImportOptions::strict_weights on every command that
 /// loads a model (scene files: model.strict_weights).

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   conform::cli::register_mesh_ops(app, context);
   conform::cli::register_run(app, context);
   conform::cli::register_scenes(app, context);
+  conform::cli::register_sweep(app, context);
   refuse_non_finite_numbers(app);
   app.require_subcommand(0, 1);
   try {

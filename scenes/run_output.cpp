@@ -133,8 +133,8 @@ void write_axes(std::ostream& gp, const Plot& p) {
 
 }  // namespace
 
-bool RunOutput::draw(const Plot& plot, std::string& problem) const {
-  const fs::path script = dir_ / (plot.name + ".gp");
+bool draw_plot(const fs::path& dir, const Plot& plot, std::string& problem) {
+  const fs::path script = dir / (plot.name + ".gp");
   {
     std::ofstream gp(script);
     if (!gp) {
@@ -156,15 +156,19 @@ bool RunOutput::draw(const Plot& plot, std::string& problem) const {
       gp << "unset multiplot\n";
     }
   }
-  const std::string cmd = "cd " + quote(dir_.string()) + " && gnuplot " + quote(plot.name + ".gp") +
+  const std::string cmd = "cd " + quote(dir.string()) + " && gnuplot " + quote(plot.name + ".gp") +
                           " > " + quote(plot.name + ".log") + " 2>&1";
   const int rc = std::system(cmd.c_str());
   if (rc != 0) {
     problem = "gnuplot failed (see " + plot.name + ".log in the output folder)";
     return false;
   }
-  fs::remove(dir_ / (plot.name + ".log"));
+  fs::remove(dir / (plot.name + ".log"));
   return true;
+}
+
+bool have_gnuplot() {
+  return std::system("command -v gnuplot > /dev/null 2>&1") == 0;
 }
 
 namespace {
@@ -197,10 +201,10 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   const double wall = std::chrono::duration<double>(Clock::now() - start_).count();
   Json plots = Json::object();
   if (common_.plots) {
-    const bool have_gnuplot = std::system("command -v gnuplot > /dev/null 2>&1") == 0;
+    const bool gnuplot = have_gnuplot();
     for (const auto& p : plots_) {
       std::string problem = "gnuplot is not installed (scripts/deps.sh installs gnuplot-nox)";
-      if (have_gnuplot && draw(p, problem))
+      if (gnuplot && draw_plot(dir_, p, problem))
         plots[p.name] = p.name + ".png";
       else
         plots[p.name] = "not drawn: " + problem;

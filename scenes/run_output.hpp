@@ -98,8 +98,6 @@ class RunOutput {
                                double simulated_seconds, double loop_seconds);
 
  private:
-  bool draw(const Plot& plot, std::string& problem) const;
-
   std::filesystem::path dir_;
   CommonSettings common_;
   Clock::time_point start_;
@@ -110,6 +108,13 @@ class RunOutput {
   bool tty_ = false;
   int last_percent_ = -1;
 };
+
+/// Draws `plot` into dir/NAME.png with gnuplot (the script is kept as dir/NAME.gp); series
+/// files are relative to `dir`. False with `problem` set when gnuplot failed or is missing.
+/// RunOutput and `conform sweep` draw through this one function.
+bool draw_plot(const std::filesystem::path& dir, const Plot& plot, std::string& problem);
+/// Whether gnuplot is on the PATH.
+bool have_gnuplot();
 
 /// Reads the common keys (scene, seed, duration, physics, outputs) of a scene object.
 CommonSettings read_common(Reader& root, const std::string& name, double default_duration,

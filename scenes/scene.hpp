@@ -39,6 +39,9 @@ struct SceneKind {
   const char* json;     // the built-in scene file (`conform scenes --show NAME`)
   SceneFactory factory;
   int rank;  // position in `conform scenes` (smaller first)
+  /// The metrics `conform sweep` plots by default: comma-separated keys of summary.json's
+  /// "metrics", nested keys dotted (e.g. "physics.max_opening").
+  const char* headline = "";
 };
 
 /// Registers a scene kind during static initialisation. In the scene's file:

@@ -587,7 +587,7 @@ const SceneRegistration kArmTrackRegistration{
     {"arm-track",
      "btMultiBody arm driven by CGA IK along a figure-eight and random waypoints, skin by CGA "
      "skinning; tracking error with/without gravity compensation",
-     kArmTrackJson, &make_arm_track, 1}};
+     kArmTrackJson, &make_arm_track, 1, "rms_error,max_error"}};
 
 }  // namespace
 }  // namespace conform::scenes

@@ -188,7 +188,7 @@ const SceneRegistration kMembraneSlitRegistration{
     {"membrane-slit",
      "the skin membrane against LEFM: a pinned, pre-stressed sheet slit through its centre "
      "opens as an ellipse of maximum 4 sigma_n a / E",
-     kMembraneSlitJson, &make_membrane_slit, 5}};
+     kMembraneSlitJson, &make_membrane_slit, 5, "w_max_over_lefm,w_max"}};
 
 }  // namespace
 

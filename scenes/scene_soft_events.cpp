@@ -479,16 +479,16 @@ const SceneRegistration kCutRegistration{
     {"cut",
      "a planar cut through the forearm of the moving soft arm; the pieces keep simulating under "
      "gravity, the hand piece stays skinned to its bones",
-     kCutJson, &make_cut, 2}};
+     kCutJson, &make_cut, 2, "offset_max,offset_mean"}};
 const SceneRegistration kDrillRegistration{
     {"drill",
      "a hole drilled through the upper arm, then the arm moves; the hole's rim stays on the skin",
-     kDrillJson, &make_drill, 3}};
+     kDrillJson, &make_drill, 3, "offset_max,offset_mean"}};
 const SceneRegistration kCharacterRegistration{
     {"character",
      "a real rigged model (assimp) plays its animation through CGA skinning with soft-body "
      "secondary motion",
-     kCharacterJson, &make_character, 4}};
+     kCharacterJson, &make_character, 4, "secondary_motion_max_m"}};
 
 }  // namespace
 }  // namespace conform::scenes

@@ -10,6 +10,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev
   gnuplot-nox  # conform run draws its PNG plots with it
   libcgal-dev  # optional: the cut's caps (constrained Delaunay) and the cut benchmark's CGAL clip
+  slurmctld slurmd slurm-client munge  # sweep_slurm_test: a one-node Slurm cluster
 )
 
 missing=()

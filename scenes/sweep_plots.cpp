@@ -1,0 +1,154 @@
+#include "sweep_plots.hpp"
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "run_output.hpp"
+#include "scene.hpp"
+
+namespace conform::scenes {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> split_commas(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+bool numeric(const std::string& s, double& x) {
+  char* end = nullptr;
+  x = std::strtod(s.c_str(), &end);
+  return end != s.c_str() && *end == '\0';
+}
+
+// gnuplot's enhanced text reads _ ^ { } @ & as markup; metric and key names are literal.
+std::string literal(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (std::string("_^{}@&").find(c) != std::string::npos) out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+std::string file_stem(const std::string& s) {
+  std::string out;
+  for (char c : s) out += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return out;
+}
+
+// One line: mean of the metric over the rows with the same x (the repeats).
+using Line = std::map<double, std::pair<double, int>>;
+
+}  // namespace
+
+std::vector<std::string> plot_metrics(const SweepSpec& spec, const SweepTable& table) {
+  std::vector<std::string> metrics = spec.plot;
+  if (metrics.empty()) {
+    const SceneKind* kind = find_builtin(spec.kind);
+    metrics = split_commas(kind && kind->headline ? kind->headline : "");
+  }
+  bool any_done = false;
+  for (const auto& r : table.rows) any_done |= r.status.state == PointStatus::State::Done;
+  if (!any_done) return metrics;
+  for (const auto& m : metrics)
+    if (std::find(table.columns.begin(), table.columns.end(), "metrics." + m) ==
+        table.columns.end()) {
+      std::string known;
+      for (const auto& c : table.columns)
+        if (c.rfind("metrics.", 0) == 0) known += (known.empty() ? "" : ", ") + c.substr(8);
+      throw SceneError("--plot", m, "is not a numeric metric of this scene (known: " + known + ")");
+    }
+  return metrics;
+}
+
+namespace {
+
+// The lines of `metric` against axis `x`: keyed by the other axes' values.
+std::map<std::string, Line> lines_of(const SweepTable& table, std::size_t x,
+                                     const std::string& metric) {
+  std::map<std::string, Line> lines;
+  for (const auto& r : table.rows) {
+    const auto y = table.value(r, "metrics." + metric);
+    double xv = 0;
+    if (!y || !numeric(r.point->values[x].second, xv)) continue;
+    std::string others;
+    for (std::size_t a = 0; a < r.point->values.size(); ++a)
+      if (a != x)
+        others += (others.empty() ? "" : ", ") + r.point->values[a].first + " = " +
+                  r.point->values[a].second;
+    auto& [sum, n] = lines[others.empty() ? "all runs" : others][xv];
+    sum += *y;
+    ++n;
+  }
+  return lines;
+}
+
+Plot sweep_plot(const SweepSpec& spec, const SweepTable& table, std::size_t x,
+                const std::string& metric, const fs::path& plots_dir) {
+  const std::string& key = spec.axes[x].key;
+  Plot plot;
+  plot.name = file_stem(metric) + "_vs_" + file_stem(key);
+  std::string units;
+  for (const auto& r : table.rows) units = units.empty() ? r.units : units;
+  plot.title = literal(spec.kind + ": " + metric + " against " + key) +
+               (units.empty() ? "" : "  {/*0.8 (" + literal(units) + ")}");
+  plot.xlabel = literal(key);
+  plot.ylabel = literal(metric) +
+                (spec.repeat > 1 ? " (mean of " + std::to_string(spec.repeat) + " seeds)" : "");
+  int n = 0;
+  for (const auto& [title, line] : lines_of(table, x, metric)) {
+    const std::string data = "data/" + plot.name + "_" + std::to_string(n++) + ".csv";
+    std::ofstream out(plots_dir / data);
+    out << "x,y\n";
+    char buf[64];
+    for (const auto& [xv, sum_n] : line) {
+      std::snprintf(buf, sizeof buf, "%.9g,%.9g\n", xv, sum_n.first / sum_n.second);
+      out << buf;
+    }
+    plot.series.push_back({data, "x", "y", literal(title), "linespoints"});
+  }
+  return plot;
+}
+
+}  // namespace
+
+SweepPlots draw_sweep_plots(const SweepSpec& spec, const SweepTable& table, const fs::path& dir) {
+  SweepPlots result;
+  const fs::path plots_dir = dir / "plots";
+  std::error_code ec;
+  fs::create_directories(plots_dir / "data", ec);
+  if (ec) {
+    result.problems.push_back("cannot create " + (plots_dir / "data").string());
+    return result;
+  }
+  const bool gnuplot = have_gnuplot();
+  for (const auto& metric : plot_metrics(spec, table)) {
+    for (std::size_t x = 0; x < spec.axes.size(); ++x) {
+      double v = 0;
+      int numbers = 0;
+      for (const auto& value : spec.axes[x].values) numbers += numeric(value, v);
+      if (numbers < 2) continue;  // a key of words, or one value: only a line label
+      const Plot plot = sweep_plot(spec, table, x, metric, plots_dir);
+      std::string problem = "gnuplot is not installed (scripts/deps.sh installs gnuplot-nox)";
+      if (plot.series.empty())
+        result.problems.push_back(plot.name + ": no finished run has " + metric);
+      else if (gnuplot && draw_plot(plots_dir, plot, problem))
+        result.drawn.push_back((plots_dir / (plot.name + ".png")).string());
+      else
+        result.problems.push_back(plot.name + ": " + problem);
+    }
+  }
+  return result;
+}
+
+}  // namespace conform::scenes

@@ -1,0 +1,28 @@
+// The plots of a sweep: each chosen metric against each grid key that has at least two
+// numeric values, one line per combination of the other keys' values (repeats averaged),
+// drawn by gnuplot through draw_plot (run_output.hpp) into DIR/plots/METRIC_vs_KEY.png, with
+// the data of every line in DIR/plots/data/.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "sweep_table.hpp"
+
+namespace conform::scenes {
+
+struct SweepPlots {
+  std::vector<std::string> drawn;     // PNG paths
+  std::vector<std::string> problems;  // why a plot was not drawn
+};
+
+/// The metrics to plot: `requested` (names of summary.json "metrics" keys, dotted), or when
+/// empty the scene kind's headline metrics. Throws SceneError for an unknown name once some
+/// run has finished (the table then knows every metric).
+std::vector<std::string> plot_metrics(const SweepSpec& spec, const SweepTable& table);
+
+SweepPlots draw_sweep_plots(const SweepSpec& spec, const SweepTable& table,
+                            const std::filesystem::path& dir);
+
+}  // namespace conform::scenes

@@ -1,0 +1,49 @@
+// One point of a sweep run as its own `conform run` child process (the same binary,
+// /proc/self/exe), into DIR/runs/NNNNN: run.log (its stdout), run.err (its stderr) and
+// status.json (exit status, error, wall time), next to what the run itself writes.
+// A point is finished when its summary.json is complete; finished points are not run again.
+#pragma once
+
+#include <sys/types.h>
+
+#include <filesystem>
+#include <string>
+
+#include "sweep_spec.hpp"
+
+namespace conform::scenes {
+
+struct PointStatus {
+  enum class State { Missing, Done, Failed };
+  State state = State::Missing;
+  int exit_code = -1;  // of `conform run` (-1: not known)
+  std::string error;   // the run's last line on stderr, or how it died
+  double wall_s = 0;   // of the child process, as the sweep measured it
+};
+
+/// Whether `folder`/summary.json is a complete summary (written last and atomically by a run).
+bool summary_complete(const std::filesystem::path& folder);
+
+/// The point's state from its folder: Done with a complete summary, Failed with a status.json
+/// that records a failure, Missing otherwise.
+PointStatus read_status(const std::filesystem::path& folder);
+
+/// A started child: its pid and when it started.
+struct PointProcess {
+  pid_t pid = -1;
+  int index = -1;
+  double started = 0;  // seconds on the monotonic clock
+};
+
+/// Starts the point's `conform run` (stdout and stderr to the folder, stdin from /dev/null).
+/// Throws std::runtime_error when the process cannot be started.
+PointProcess start_point(const SweepSpec& spec, const std::filesystem::path& dir, int index);
+
+/// Records a child that ended with wait status `wstatus` into status.json; returns the status.
+PointStatus finish_point(const std::filesystem::path& dir, const PointProcess& process,
+                         int wstatus);
+
+/// Seconds on the monotonic clock.
+double monotonic_seconds();
+
+}  // namespace conform::scenes
