@@ -115,6 +115,11 @@ int sweep_main(const SweepArgs& a) {
     return r.failed > 0 ? 1 : 0;
   }
   if (a.out.empty()) throw scenes::SceneError("--out", "(none)", "is required for a sweep");
+  scenes::SlurmOptions slurm;
+  slurm.partition = a.partition;
+  slurm.time = a.time;
+  slurm.array_limit = a.array_limit;
+  scenes::check_slurm_options(slurm);
   const SweepSpec spec = plan(a);
   const fs::path dir = a.out;
   claim_folder(spec, dir);
@@ -122,11 +127,8 @@ int sweep_main(const SweepArgs& a) {
             << dir.string() << "\n"
             << std::flush;
   if (a.slurm || a.submit) {
-    scenes::SlurmOptions o;
-    o.partition = a.partition;
-    o.time = a.time;
-    o.array_limit = a.array_limit;
-    const fs::path file = scenes::write_sbatch(spec, dir, fs::read_symlink("/proc/self/exe"), o);
+    const fs::path file =
+        scenes::write_sbatch(spec, dir, fs::read_symlink("/proc/self/exe"), slurm);
     std::cout << "job array: " << file.string() << "\n";
     if (!a.submit) {
       std::cout << "submit it with: sbatch " << file.string() << "\n";
@@ -137,8 +139,7 @@ int sweep_main(const SweepArgs& a) {
     return 0;
   }
   const int jobs = a.jobs > 0 ? a.jobs : int(std::max(1u, std::thread::hardware_concurrency()));
-  const auto r = scenes::run_pool(spec, dir, jobs);
-  (void)r;
+  scenes::run_pool(spec, dir, jobs);
   return gather(spec, dir);
 }
 

@@ -461,8 +461,7 @@ const SceneRegistration kTearOpeningRegistration{
      "the skinned arm's pre-stressed skin torn by a scalpel: physical opening (membrane in Bullet) "
      "vs "
      "the geometric opening of Algorithm 2 step 6, profiles over time (default scene)",
-     kTearOpeningJson, &make_tear_opening, 0,
-     "physics.max_opening,geometric.max_opening"}};
+     kTearOpeningJson, &make_tear_opening, 0, "physics.max_opening,geometric.max_opening"}};
 
 }  // namespace
 }  // namespace conform::scenes

@@ -23,7 +23,8 @@ struct SweepPoint {
   int index = 0;                                            // 0-based, the --task number
   std::vector<std::pair<std::string, std::string>> values;  // one per axis, in axis order
   int repeat = 0;                                           // 0 .. repeat-1
-  std::uint64_t seed = 0;  // set with --set seed=... when repeating (0: the scene's own)
+  std::uint64_t seed = 0;      // set with --set seed=... when repeating (0: the scene's own)
+  std::uint64_t run_seed = 0;  // the seed the run uses (known once the point is validated)
 
   /// The `--set` assignments of this point (its values, then the seed when repeating).
   std::vector<std::string> assignments() const;

@@ -26,16 +26,20 @@ void check_word(const std::string& option, const std::string& value) {
 
 }  // namespace
 
-fs::path write_sbatch(const SweepSpec& spec, const fs::path& dir, const fs::path& conform,
-                      const SlurmOptions& options) {
+void check_slurm_options(const SlurmOptions& options) {
   check_word("--partition", options.partition);
   check_word("--time", options.time);
   if (!options.time.empty() &&
-      !std::regex_match(options.time, std::regex(R"((\d+-)?\d+(:\d+){0,2}|\d+-\d+)")))
+      !std::regex_match(options.time, std::regex(R"((\d+-)?\d+(:\d+){0,2})")))
     throw SceneError("--time", options.time,
                      "is not a Slurm time (MINUTES, HH:MM:SS, D-HH:MM:SS, ...)");
   if (options.array_limit < 0)
     throw SceneError("--array-limit", std::to_string(options.array_limit), "must be >= 0");
+}
+
+fs::path write_sbatch(const SweepSpec& spec, const fs::path& dir, const fs::path& conform,
+                      const SlurmOptions& options) {
+  check_slurm_options(options);
   const fs::path abs = fs::absolute(dir).lexically_normal();
   std::error_code ec;
   fs::create_directories(abs / "slurm", ec);

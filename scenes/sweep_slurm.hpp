@@ -17,6 +17,9 @@ struct SlurmOptions {
   std::string job_name = "conform-sweep";
 };
 
+/// Throws SceneError naming a bad option (a value with spaces, a time Slurm would not read).
+void check_slurm_options(const SlurmOptions& options);
+
 /// Writes DIR/sweep.sbatch (and creates DIR/slurm for the tasks' logs); returns its path.
 /// `conform` is the absolute path of the binary the tasks run. Throws on a bad option.
 std::filesystem::path write_sbatch(const SweepSpec& spec, const std::filesystem::path& dir,

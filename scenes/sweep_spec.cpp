@@ -44,7 +44,8 @@ Json to_json(const SweepSpec& spec) {
                            {"folder", point_dir("", p.index).string()},
                            {"values", values},
                            {"repeat", p.repeat},
-                           {"seed", p.seed}});
+                           {"seed", p.seed},
+                           {"run_seed", p.run_seed}});
   }
   return j;
 }
@@ -74,6 +75,7 @@ SweepSpec from_json(const Json& j) {
       point.values.emplace_back(a.key, p.at("values").at(a.key).get<std::string>());
     point.repeat = p.at("repeat").get<int>();
     point.seed = p.at("seed").get<std::uint64_t>();
+    point.run_seed = p.at("run_seed").get<std::uint64_t>();
     s.points.push_back(std::move(point));
   }
   return s;
@@ -103,12 +105,13 @@ void write_spec(const fs::path& dir, const SweepSpec& spec) {
 }
 
 void validate_points(SweepSpec& spec) {
-  for (const auto& p : spec.points) {
+  for (auto& p : spec.points) {
     std::vector<std::string> sets = spec.sets;
     for (const auto& a : p.assignments()) sets.push_back(a);
     try {
       const auto scene = load_scene(spec.scene, sets, spec.steps);
       spec.kind = scene->common().kind;
+      p.run_seed = scene->common().seed;
     } catch (const SceneError& e) {
       throw SceneError(e.key(), e.value(),
                        e.reason() + " (point " + std::to_string(p.index) + ": " + p.label() + ")");

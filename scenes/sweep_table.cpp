@@ -53,7 +53,7 @@ SweepTable gather_table(const SweepSpec& spec, const fs::path& dir) {
     SweepRow row;
     row.point = &p;
     row.status = read_status(folder);
-    row.seed = p.seed;
+    row.seed = p.run_seed;
     if (row.status.state == PointStatus::State::Missing) {
       t.missing.push_back(p.index);
       continue;
@@ -61,7 +61,7 @@ SweepTable gather_table(const SweepSpec& spec, const fs::path& dir) {
     if (row.status.state == PointStatus::State::Done) {
       std::ifstream in(folder / "summary.json");
       const Json s = Json::parse(in, nullptr, false);
-      row.seed = s.value("seed", p.seed);
+      row.seed = s.value("seed", p.run_seed);
       flatten(s["timings"], "timings.", row.numbers);
       flatten(s["metrics"], "metrics.", row.numbers);
       if (s["metrics"].contains("units") && s["metrics"]["units"].is_string())

@@ -1,0 +1,180 @@
+#!/usr/bin/env bash
+# `conform sweep`, local path: a 2 x 3 grid gives 6 rows with the right values (checked against
+# each run's own summary.json and against a separate `conform run` of one point), a rerun skips
+# finished points, an injected failing point is reported while the others complete, the plots
+# exist, --task/--gather run and collect points one by one, the job array file is well-formed,
+# and bad grids are refused before anything runs.
+# Usage: bash sweep_test.sh <conform> <source dir> <build dir>
+set -euo pipefail
+conform="$(realpath "$1")"
+tmp="$(realpath "$(mktemp -d)")"
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "sweep_test: $*" >&2; exit 1; }
+# A short arm-track: 20 steps at resolution 1, no frames (about 0.1 s a run).
+short=(--steps 20 --set outputs.frames_every=0)
+
+# --- 2 x 3 grid: 6 rows, each with its own values -------------------------------------------
+"$conform" sweep arm-track --grid arm.kp=0.3,0.5 --grid physics.substeps=1,2,4 "${short[@]}" \
+  --jobs 2 --out "$tmp/grid" > "$tmp/grid.log" 2>&1 || { cat "$tmp/grid.log" >&2; fail "grid sweep failed"; }
+python3 - "$tmp/grid" <<'PY' || fail "grid table is wrong"
+import csv, json, sys, itertools
+d = sys.argv[1]
+rows = list(csv.DictReader(open(d + "/sweep.csv")))
+assert len(rows) == 6, f"{len(rows)} rows, not 6"
+pairs = [(r["arm.kp"], r["physics.substeps"]) for r in rows]
+assert pairs == list(itertools.product(["0.3", "0.5"], ["1", "2", "4"])), pairs
+for r in rows:
+    assert r["status"] == "ok" and r["exit_code"] == "0", r
+    s = json.load(open(f"{d}/runs/{int(r['point']):05d}/summary.json"))
+    # The run really used the row's values, and the row holds the run's metrics.
+    assert s["settings"]["arm"]["kp"] == float(r["arm.kp"]), (s["settings"]["arm"], r)
+    assert s["settings"]["physics"]["substeps"] == int(r["physics.substeps"])
+    assert s["timings"]["steps"] == 20
+    assert abs(float(r["metrics.rms_error"]) - s["metrics"]["rms_error"]) <= 1e-8 * s["metrics"]["rms_error"]
+    assert float(r["metrics.with_gravity_compensation.max_error"]) > 0  # nested keys are flattened
+    assert int(r["seed"]) == s["seed"] == 7
+    assert float(r["run_wall_s"]) > 0 and float(r["timings.wall_s"]) > 0
+# Different settings give different results (the values reached the runs).
+assert len({r["metrics.rms_error"] for r in rows}) == 6
+spec = json.load(open(d + "/sweep.json"))
+assert [g["key"] for g in spec["grid"]] == ["arm.kp", "physics.substeps"]
+assert spec["command"].startswith("conform sweep arm-track") and spec["version"]
+assert len(spec["points"]) == 6
+PY
+# One point again, as a plain `conform run`: the same number as the sweep's row.
+"$conform" run arm-track "${short[@]}" --set arm.kp=0.5 --set physics.substeps=2 \
+  --out "$tmp/single" > /dev/null 2>&1 || fail "single run failed"
+python3 - "$tmp" <<'PY' || fail "the sweep's row differs from a plain conform run"
+import csv, json, sys
+t = sys.argv[1]
+row = [r for r in csv.DictReader(open(t + "/grid/sweep.csv")) if r["arm.kp"] == "0.5" and r["physics.substeps"] == "2"][0]
+ref = json.load(open(t + "/single/summary.json"))["metrics"]["rms_error"]
+assert abs(float(row["metrics.rms_error"]) - ref) <= 1e-8 * ref, (row["metrics.rms_error"], ref)
+PY
+# Plots: each headline metric (rms_error, max_error) against each numeric key.
+for m in rms_error max_error; do
+  for k in arm_kp physics_substeps; do
+    png="$tmp/grid/plots/${m}_vs_${k}.png"
+    [[ -s "$png" ]] || fail "no plot $png"
+    [[ "$(head -c 8 "$png" | od -An -tx1 | tr -d ' \n')" == "89504e470d0a1a0a" ]] || fail "$png is not a PNG"
+  done
+done
+# One line per value of the other key.
+[[ $(grep -c '^     "data/\|^plot "data/' "$tmp/grid/plots/rms_error_vs_physics_substeps.gp") -eq 2 ]] ||
+  fail "rms_error vs substeps should have 2 lines (one per arm.kp)"
+grep -q 'arm.kp = 0.3' "$tmp/grid/plots/rms_error_vs_physics_substeps.gp" || fail "no legend per line"
+
+# --- a rerun skips finished points ------------------------------------------------------------
+stamp="$(stat -c %Y.%N "$tmp/grid/runs/00003/summary.json")"
+rm -rf "$tmp/grid/runs/00004"  # one point lost: only it runs again
+"$conform" sweep arm-track --grid arm.kp=0.3,0.5 --grid physics.substeps=1,2,4 "${short[@]}" \
+  --out "$tmp/grid" > "$tmp/rerun.log" 2>&1 || { cat "$tmp/rerun.log" >&2; fail "rerun failed"; }
+grep -q "5 of 6 points already finished, skipped" "$tmp/rerun.log" || { cat "$tmp/rerun.log" >&2; fail "rerun did not skip"; }
+[[ $(grep -c "^sweep: point" "$tmp/rerun.log") -eq 1 ]] || fail "rerun ran more than the lost point"
+[[ "$(stat -c %Y.%N "$tmp/grid/runs/00003/summary.json")" == "$stamp" ]] || fail "a finished point was rewritten"
+[[ $(tail -n +2 "$tmp/grid/sweep.csv" | wc -l) -eq 6 ]] || fail "rerun table does not have 6 rows"
+# A different grid into the same folder is refused.
+rc=0; "$conform" sweep arm-track --grid arm.kp=0.3 "${short[@]}" --out "$tmp/grid" 2> "$tmp/err" > /dev/null || rc=$?
+[[ $rc -eq 2 ]] && grep -q "holds another sweep" "$tmp/err" || fail "another sweep into the same folder was not refused"
+
+# --- an injected failing point: reported, the others complete ---------------------------------
+# Point 1's frames folder is a file: its `conform run` fails to create it (exit 1).
+mkdir -p "$tmp/fail/runs/00001" && touch "$tmp/fail/runs/00001/frames"
+rc=0
+"$conform" sweep arm-track --grid arm.kp=0.3,0.5,0.7 "${short[@]}" --jobs 2 --out "$tmp/fail" \
+  > "$tmp/fail.log" 2>&1 || rc=$?
+[[ $rc -eq 1 ]] || { cat "$tmp/fail.log" >&2; fail "a sweep with a failed point should exit 1, not $rc"; }
+grep -q "failed: point 1 (arm.kp=0.5): exit 1: .*cannot create .*frames" "$tmp/fail.log" ||
+  { cat "$tmp/fail.log" >&2; fail "the failure is not reported with its error"; }
+python3 - "$tmp/fail" <<'PY' || fail "failure table is wrong"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1] + "/sweep.csv")))
+assert [r["status"] for r in rows] == ["ok", "failed", "ok"], [r["status"] for r in rows]
+assert rows[1]["exit_code"] == "1" and "cannot create" in rows[1]["error"] and rows[1]["metrics.rms_error"] == ""
+assert rows[1]["seed"] == "7"
+assert all(float(rows[i]["metrics.rms_error"]) > 0 for i in (0, 2))
+PY
+# Fixed, the rerun runs only the failed point and the sweep completes.
+rm "$tmp/fail/runs/00001/frames"
+"$conform" sweep arm-track --grid arm.kp=0.3,0.5,0.7 "${short[@]}" --out "$tmp/fail" > "$tmp/fail2.log" 2>&1 ||
+  { cat "$tmp/fail2.log" >&2; fail "the fixed rerun failed"; }
+grep -q "2 of 3 points already finished" "$tmp/fail2.log" || fail "the fixed rerun did not skip the finished points"
+
+# --- --zip and --repeat -------------------------------------------------------------------------
+"$conform" sweep arm-track --zip arm.kp=0.3,0.5 --zip physics.substeps=1,2 --repeat 2 "${short[@]}" \
+  --plot rms_error --out "$tmp/zip" > "$tmp/zip.log" 2>&1 || { cat "$tmp/zip.log" >&2; fail "zip sweep failed"; }
+python3 - "$tmp/zip" <<'PY' || fail "zip/repeat table is wrong"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1] + "/sweep.csv")))
+got = [(r["arm.kp"], r["physics.substeps"], r["repeat"], r["seed"]) for r in rows]
+assert got == [("0.3", "1", "0", "1"), ("0.3", "1", "1", "2"), ("0.5", "2", "0", "1"), ("0.5", "2", "1", "2")], got
+PY
+[[ -s "$tmp/zip/plots/rms_error_vs_arm_kp.png" && ! -e "$tmp/zip/plots/max_error_vs_arm_kp.png" ]] ||
+  fail "--plot rms_error should draw rms_error only"
+
+# --- --slurm writes a well-formed job array; --task and --gather run it by hand ---------------
+"$conform" sweep arm-track --grid arm.kp=0.3,0.5 --grid physics.substeps=1,2 "${short[@]}" \
+  --slurm --partition debug --time 00:05:00 --array-limit 3 --out "$tmp/task" > "$tmp/slurm.log" 2>&1 ||
+  { cat "$tmp/slurm.log" >&2; fail "--slurm failed"; }
+sb="$tmp/task/sweep.sbatch"
+bash -n "$sb" || fail "sweep.sbatch is not valid bash"
+[[ "$(head -1 "$sb")" == "#!/bin/bash" ]] || fail "sweep.sbatch has no shebang"
+for line in "#SBATCH --array=0-3%3" "#SBATCH --partition=debug" "#SBATCH --time=00:05:00" \
+            "#SBATCH --chdir=$tmp/task" "#SBATCH --output=$tmp/task/slurm/%A_%a.out"; do
+  grep -qxF -- "$line" "$sb" || fail "sweep.sbatch lacks '$line'"
+done
+# Slurm stops reading #SBATCH lines at the first command.
+awk '/^[^#]/ {cmd=1} /^#SBATCH/ && cmd {exit 1}' "$sb" || fail "an #SBATCH line follows a command"
+grep -qxF "exec '$conform' sweep --task \"\$SLURM_ARRAY_TASK_ID\" '$tmp/task'" "$sb" || fail "the task line is wrong"
+[[ ! -e "$tmp/task/runs/00000" ]] || fail "--slurm ran a point"
+# Two of four tasks, as a scheduler would run them (the array's own command line).
+for n in 0 3; do
+  (cd / && SLURM_ARRAY_TASK_ID=$n bash -c "$(tail -1 "$sb")") > "$tmp/task$n.log" 2>&1 || fail "task $n failed"
+done
+rc=0; "$conform" sweep --gather "$tmp/task" > "$tmp/gather.log" 2>&1 || rc=$?
+[[ $rc -eq 1 ]] || fail "gather with missing points should exit 1, not $rc"
+grep -q "2 of 4 points finished, 0 failed, 2 missing" "$tmp/gather.log" || { cat "$tmp/gather.log" >&2; fail "gather count"; }
+grep -q "missing: point 1 (arm.kp=0.3, physics.substeps=2)" "$tmp/gather.log" || fail "gather does not list the missing point"
+grep -q "missing: point 2 (arm.kp=0.5, physics.substeps=1)" "$tmp/gather.log" || fail "gather does not list the missing point"
+[[ $(tail -n +2 "$tmp/task/sweep.csv" | wc -l) -eq 2 ]] || fail "partial table should have 2 rows"
+for n in 1 2; do "$conform" sweep --task $n "$tmp/task" > /dev/null 2>&1 || fail "task $n failed"; done
+"$conform" sweep --task 0 "$tmp/task" > "$tmp/again.log" 2>&1 || fail "a finished task should succeed"
+grep -q "already finished" "$tmp/again.log" || fail "a finished task ran again"
+"$conform" sweep --gather "$tmp/task" > "$tmp/gather2.log" 2>&1 || { cat "$tmp/gather2.log" >&2; fail "full gather failed"; }
+# The tasks' table equals the local pool's for the same points (metrics are deterministic).
+python3 - "$tmp" <<'PY' || fail "task table differs from the local one"
+import csv, sys
+t = sys.argv[1]
+key = lambda r: (r["arm.kp"], r["physics.substeps"])
+local = {key(r): r for r in csv.DictReader(open(t + "/grid/sweep.csv"))}
+tasks = list(csv.DictReader(open(t + "/task/sweep.csv")))
+assert len(tasks) == 4
+for r in tasks:
+    assert r["metrics.rms_error"] == local[key(r)]["metrics.rms_error"], (r, local[key(r)])
+PY
+
+# --- bad grids are refused before anything runs (the --set validation) -------------------------
+expect_refused() {  # expect_refused <stderr pattern> <args...>
+  local pattern="$1"; shift
+  rm -rf "$tmp/bad"; local rc=0
+  "$conform" sweep arm-track "$@" --out "$tmp/bad" > /dev/null 2> "$tmp/err" || rc=$?
+  [[ $rc -eq 2 ]] || fail "sweep $* should exit 2, not $rc"
+  grep -q -- "$pattern" "$tmp/err" || { cat "$tmp/err" >&2; fail "sweep $*: no '$pattern'"; }
+  [[ ! -e "$tmp/bad" ]] || fail "sweep $* wrote $tmp/bad"
+}
+expect_refused "key 'physics.dtt', value 0.01: unknown key" --grid physics.dtt=0.01,0.02
+expect_refused "key 'physics.dt', value -1: must be in \[1e-05, 0.1\] (point 1: physics.dt=-1)" --grid physics.dt=0.01,-1
+expect_refused "key 'arm.gravity_compensation', value \"sometimes\": must be one of" --grid arm.gravity_compensation=both,sometimes
+expect_refused "key 'targets.center', value \[1\]: must be an array of 3 numbers" --grid 'targets.center=[0,-0.25,0.3],[1]'
+expect_refused "--grid needs KEY=V1,V2" --grid arm.kp
+expect_refused "lists this value twice" --grid arm.kp=0.3,0.3
+expect_refused "is swept twice" --grid arm.kp=0.3 --grid arm.kp=0.5
+expect_refused "--zip axes must have the same length" --zip arm.kp=0.3,0.5 --zip physics.substeps=1,2,3
+expect_refused "cannot be swept with --repeat" --grid seed=1,2 --repeat 2
+expect_refused "key '--time', value \"10 minutes\": must be one word" --grid arm.kp=0.3 --slurm --time "10 minutes"
+expect_refused "key '--time', value 1:2:3:4: is not a Slurm time" --grid arm.kp=0.3 --slurm --time 1:2:3:4
+rc=0; "$conform" sweep --task 9 "$tmp/task" 2> "$tmp/err" || rc=$?
+[[ $rc -eq 2 ]] && grep -q "is not a point of this sweep (0..3)" "$tmp/err" || fail "--task 9 was not refused"
+rc=0; "$conform" sweep --gather "$tmp/nothing" 2> "$tmp/err" || rc=$?
+[[ $rc -eq 2 ]] && grep -q "sweep.json: cannot read" "$tmp/err" || fail "--gather of a non-sweep was not refused"
+echo "sweep_test: ok"
