@@ -51,24 +51,10 @@ using Line = std::map<double, std::pair<double, int>>;
 
 }  // namespace
 
-std::vector<std::string> plot_metrics(const SweepSpec& spec, const SweepTable& table) {
-  std::vector<std::string> metrics = spec.plot;
-  if (metrics.empty()) {
-    const SceneKind* kind = find_builtin(spec.kind);
-    metrics = split_commas(kind && kind->headline ? kind->headline : "");
-  }
-  bool any_done = false;
-  for (const auto& r : table.rows) any_done |= r.status.state == PointStatus::State::Done;
-  if (!any_done) return metrics;
-  for (const auto& m : metrics)
-    if (std::find(table.columns.begin(), table.columns.end(), "metrics." + m) ==
-        table.columns.end()) {
-      std::string known;
-      for (const auto& c : table.columns)
-        if (c.rfind("metrics.", 0) == 0) known += (known.empty() ? "" : ", ") + c.substr(8);
-      throw SceneError("--plot", m, "is not a numeric metric of this scene (known: " + known + ")");
-    }
-  return metrics;
+std::vector<std::string> plot_metrics(const SweepSpec& spec) {
+  if (!spec.plot.empty()) return spec.plot;
+  const SceneKind* kind = find_builtin(spec.kind);
+  return split_commas(kind && kind->headline ? kind->headline : "");
 }
 
 namespace {
@@ -132,7 +118,18 @@ SweepPlots draw_sweep_plots(const SweepSpec& spec, const SweepTable& table, cons
     return result;
   }
   const bool gnuplot = have_gnuplot();
-  for (const auto& metric : plot_metrics(spec, table)) {
+  for (const auto& metric : plot_metrics(spec)) {
+    if (!table.rows.empty() && std::find(table.columns.begin(), table.columns.end(),
+                                         "metrics." + metric) == table.columns.end()) {
+      std::string known;
+      for (const auto& c : table.columns)
+        if (c.rfind("metrics.", 0) == 0) known += (known.empty() ? "" : ", ") + c.substr(8);
+      if (!known.empty()) {
+        result.problems.push_back(metric + ": not a numeric metric of these runs (known: " + known +
+                                  ")");
+        continue;
+      }
+    }
     for (std::size_t x = 0; x < spec.axes.size(); ++x) {
       double v = 0;
       int numbers = 0;

@@ -17,11 +17,12 @@ struct SweepPlots {
   std::vector<std::string> problems;  // why a plot was not drawn
 };
 
-/// The metrics to plot: `requested` (names of summary.json "metrics" keys, dotted), or when
-/// empty the scene kind's headline metrics. Throws SceneError for an unknown name once some
-/// run has finished (the table then knows every metric).
-std::vector<std::string> plot_metrics(const SweepSpec& spec, const SweepTable& table);
+/// The metrics to plot: spec.plot (names of summary.json "metrics" keys, dotted), or when
+/// empty the scene kind's headline metrics.
+std::vector<std::string> plot_metrics(const SweepSpec& spec);
 
+/// Draws every plot it can; a metric no finished run has (a misspelt --plot) is a problem
+/// that lists the metrics the runs do have.
 SweepPlots draw_sweep_plots(const SweepSpec& spec, const SweepTable& table,
                             const std::filesystem::path& dir);
 

@@ -102,7 +102,7 @@ grep -q "2 of 3 points already finished" "$tmp/fail2.log" || fail "the fixed rer
 
 # --- --zip and --repeat -------------------------------------------------------------------------
 "$conform" sweep arm-track --zip arm.kp=0.3,0.5 --zip physics.substeps=1,2 --repeat 2 "${short[@]}" \
-  --plot rms_error --out "$tmp/zip" > "$tmp/zip.log" 2>&1 || { cat "$tmp/zip.log" >&2; fail "zip sweep failed"; }
+  --plot rms_error,no_such_metric --out "$tmp/zip" > "$tmp/zip.log" 2>&1 || { cat "$tmp/zip.log" >&2; fail "zip sweep failed"; }
 python3 - "$tmp/zip" <<'PY' || fail "zip/repeat table is wrong"
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1] + "/sweep.csv")))
@@ -111,6 +111,8 @@ assert got == [("0.3", "1", "0", "1"), ("0.3", "1", "1", "2"), ("0.5", "2", "0",
 PY
 [[ -s "$tmp/zip/plots/rms_error_vs_arm_kp.png" && ! -e "$tmp/zip/plots/max_error_vs_arm_kp.png" ]] ||
   fail "--plot rms_error should draw rms_error only"
+grep -q "plot not drawn: no_such_metric: not a numeric metric of these runs (known: .*rms_error" "$tmp/zip.log" ||
+  { cat "$tmp/zip.log" >&2; fail "a misspelt --plot metric is not reported"; }
 
 # --- --slurm writes a well-formed job array; --task and --gather run it by hand ---------------
 "$conform" sweep arm-track --grid arm.kp=0.3,0.5 --grid physics.substeps=1,2 "${short[@]}" \
