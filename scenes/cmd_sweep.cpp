@@ -130,6 +130,10 @@ int sweep_main(const SweepArgs& a) {
     const fs::path file =
         scenes::write_sbatch(spec, dir, fs::read_symlink("/proc/self/exe"), slurm);
     std::cout << "job array: " << file.string() << "\n";
+    // Slurm refuses array indices at or above MaxArraySize, 1001 unless the site raised it.
+    if (spec.points.size() > 1001)
+      std::cout << "note: " << spec.points.size() << " tasks: Slurm's default MaxArraySize is "
+                << "1001 (`scontrol show config | grep MaxArraySize` shows the cluster's)\n";
     if (!a.submit) {
       std::cout << "submit it with: sbatch " << file.string() << "\n";
       return 0;

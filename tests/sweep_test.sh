@@ -155,6 +155,14 @@ for r in tasks:
     assert r["metrics.rms_error"] == local[key(r)]["metrics.rms_error"], (r, local[key(r)])
 PY
 
+# --- a scene file named by a relative path: the tasks find it from any folder ------------------
+"$conform" scenes --show arm-track > "$tmp/my-arm.json"
+(cd "$tmp" && "$conform" sweep my-arm.json --grid arm.kp=0.3,0.5 "${short[@]}" --slurm --out file) > /dev/null 2>&1 ||
+  fail "a sweep of a scene file failed"
+grep -q "\"scene\": \"$tmp/my-arm.json\"" "$tmp/file/sweep.json" || fail "the scene file is not kept by its absolute path"
+(cd / && "$conform" sweep --task 1 "$tmp/file") > /dev/null 2>&1 || fail "a task of a scene-file sweep failed"
+[[ -s "$tmp/file/runs/00001/summary.json" ]] || fail "the scene-file task wrote no summary"
+
 # --- bad grids are refused before anything runs (the --set validation) -------------------------
 expect_refused() {  # expect_refused <stderr pattern> <args...>
   local pattern="$1"; shift
