@@ -104,6 +104,13 @@ void claim_folder(const SweepSpec& spec, const fs::path& dir) {
 
 int sweep_main(const SweepArgs& a) {
   if (a.gather || a.task >= 0) {
+    // The sweep is what DIR/sweep.json says: options that would describe another are refused.
+    if (a.gather && a.task >= 0)
+      throw scenes::SceneError("--task", std::to_string(a.task), "and --gather are exclusive");
+    if (!a.grids.empty() || !a.zips.empty() || !a.sets.empty() || !a.plot.empty() ||
+        !a.out.empty() || a.steps > 0 || a.repeat > 1 || a.slurm || a.submit)
+      throw scenes::SceneError(a.gather ? "--gather" : "--task", a.target,
+                               "takes only the sweep folder (its sweep.json holds the rest)");
     const fs::path dir = a.target;
     const SweepSpec spec = scenes::read_spec(dir);
     if (a.gather) return gather(spec, dir);

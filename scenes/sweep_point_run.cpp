@@ -19,6 +19,11 @@ double monotonic_seconds() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
+fs::path point_record(const fs::path& dir, int index, const std::string& ext) {
+  fs::path p = point_dir(dir, index);
+  return p.replace_filename(p.filename().string() + "." + ext);
+}
+
 bool summary_complete(const fs::path& folder) {
   std::ifstream in(folder / "summary.json");
   if (!in) return false;
@@ -27,16 +32,16 @@ bool summary_complete(const fs::path& folder) {
          j.contains("timings") && j["timings"].is_object();
 }
 
-PointStatus read_status(const fs::path& folder) {
+PointStatus read_status(const fs::path& dir, int index) {
   PointStatus s;
-  std::ifstream in(folder / "status.json");
+  std::ifstream in(point_record(dir, index, "status.json"));
   const Json j = in ? Json::parse(in, nullptr, false) : Json();
   if (j.is_object()) {
     s.exit_code = j.value("exit_code", -1);
     s.error = j.value("error", "");
     s.wall_s = j.value("wall_s", 0.0);
   }
-  if (summary_complete(folder)) {
+  if (summary_complete(point_dir(dir, index))) {
     s.state = PointStatus::State::Done;
     if (s.exit_code < 0) s.exit_code = 0;  // finished, but its status was not recorded
   } else if (j.is_object() && s.exit_code != 0) {
@@ -48,9 +53,12 @@ PointStatus read_status(const fs::path& folder) {
 PointProcess start_point(const SweepSpec& spec, const fs::path& dir, int index) {
   const fs::path folder = point_dir(dir, index);
   std::error_code ec;
-  fs::create_directories(folder, ec);
-  if (ec) throw std::runtime_error("cannot create " + folder.string() + ": " + ec.message());
-  fs::remove(folder / "status.json", ec);  // a stale failure must not outlive a new attempt
+  fs::create_directories(folder.parent_path(), ec);
+  if (ec)
+    throw std::runtime_error("cannot create " + folder.parent_path().string() + ": " +
+                             ec.message());
+  // A stale failure must not outlive a new attempt.
+  fs::remove(point_record(dir, index, "status.json"), ec);
   std::vector<std::string> args = spec.run_arguments(spec.points.at(std::size_t(index)), folder);
   args.insert(args.begin(), "conform");
   std::vector<char*> argv;
@@ -58,7 +66,8 @@ PointProcess start_point(const SweepSpec& spec, const fs::path& dir, int index) 
   argv.push_back(nullptr);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
-  const std::string log = (folder / "run.log").string(), err = (folder / "run.err").string();
+  const std::string log = point_record(dir, index, "out").string(),
+                    err = point_record(dir, index, "err").string();
   posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
   posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -92,7 +101,7 @@ PointStatus finish_point(const fs::path& dir, const PointProcess& process, int w
   s.wall_s = monotonic_seconds() - process.started;
   if (WIFEXITED(wstatus)) {
     s.exit_code = WEXITSTATUS(wstatus);
-    if (s.exit_code != 0) s.error = last_line(folder / "run.err");
+    if (s.exit_code != 0) s.error = last_line(point_record(dir, process.index, "err"));
   } else if (WIFSIGNALED(wstatus)) {
     s.exit_code = 128 + WTERMSIG(wstatus);
     s.error = std::string("killed by signal ") + std::to_string(WTERMSIG(wstatus)) + " (" +
@@ -108,13 +117,14 @@ PointStatus finish_point(const fs::path& dir, const PointProcess& process, int w
                   {"exit_code", s.exit_code},
                   {"error", s.error},
                   {"wall_s", s.wall_s}};
-  const fs::path tmp = folder / ".status.json.tmp";
+  const fs::path record = point_record(dir, process.index, "status.json");
+  const fs::path tmp = record.string() + ".tmp";
   {
     std::ofstream out(tmp);
     out << j.dump(2) << "\n";
   }
   std::error_code ec;
-  fs::rename(tmp, folder / "status.json", ec);
+  fs::rename(tmp, record, ec);
   return s;
 }
 

@@ -1,7 +1,9 @@
 // One point of a sweep run as its own `conform run` child process (the same binary,
-// /proc/self/exe), into DIR/runs/NNNNN: run.log (its stdout), run.err (its stderr) and
-// status.json (exit status, error, wall time), next to what the run itself writes.
-// A point is finished when its summary.json is complete; finished points are not run again.
+// /proc/self/exe) with --out DIR/runs/NNNNN, which the run writes atomically (output_folder.hpp:
+// the folder appears complete or not at all). Beside it the sweep keeps its own records of the
+// point: NNNNN.out (the run's stdout), NNNNN.err (its stderr) and NNNNN.status.json (exit
+// status, error, wall time). A point is finished when its summary.json is complete; finished
+// points are not run again.
 #pragma once
 
 #include <sys/types.h>
@@ -21,12 +23,16 @@ struct PointStatus {
   double wall_s = 0;   // of the child process, as the sweep measured it
 };
 
-/// Whether `folder`/summary.json is a complete summary (written last and atomically by a run).
+/// DIR/runs/NNNNN.EXT: one of the sweep's records of point `index` ("out", "err", "status.json").
+std::filesystem::path point_record(const std::filesystem::path& dir, int index,
+                                   const std::string& ext);
+
+/// Whether `folder`/summary.json is a complete summary.
 bool summary_complete(const std::filesystem::path& folder);
 
-/// The point's state from its folder: Done with a complete summary, Failed with a status.json
-/// that records a failure, Missing otherwise.
-PointStatus read_status(const std::filesystem::path& folder);
+/// The point's state: Done with a complete summary, Failed with a status record of a failure,
+/// Missing otherwise.
+PointStatus read_status(const std::filesystem::path& dir, int index);
 
 /// A started child: its pid and when it started.
 struct PointProcess {

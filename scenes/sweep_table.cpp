@@ -52,7 +52,7 @@ SweepTable gather_table(const SweepSpec& spec, const fs::path& dir) {
     const fs::path folder = point_dir(dir, p.index);
     SweepRow row;
     row.point = &p;
-    row.status = read_status(folder);
+    row.status = read_status(dir, p.index);
     row.seed = p.run_seed;
     if (row.status.state == PointStatus::State::Missing) {
       t.missing.push_back(p.index);

@@ -65,40 +65,47 @@ done
 grep -q 'arm.kp = 0.3' "$tmp/grid/plots/rms_error_vs_physics_substeps.gp" || fail "no legend per line"
 
 # --- a rerun skips finished points ------------------------------------------------------------
-stamp="$(stat -c %Y.%N "$tmp/grid/runs/00003/summary.json")"
+stamp="$(stat -c %i-%Y "$tmp/grid/runs/00003/summary.json")"
 rm -rf "$tmp/grid/runs/00004"  # one point lost: only it runs again
 "$conform" sweep arm-track --grid arm.kp=0.3,0.5 --grid physics.substeps=1,2,4 "${short[@]}" \
   --out "$tmp/grid" > "$tmp/rerun.log" 2>&1 || { cat "$tmp/rerun.log" >&2; fail "rerun failed"; }
 grep -q "5 of 6 points already finished, skipped" "$tmp/rerun.log" || { cat "$tmp/rerun.log" >&2; fail "rerun did not skip"; }
 [[ $(grep -c "^sweep: point" "$tmp/rerun.log") -eq 1 ]] || fail "rerun ran more than the lost point"
-[[ "$(stat -c %Y.%N "$tmp/grid/runs/00003/summary.json")" == "$stamp" ]] || fail "a finished point was rewritten"
+[[ "$(stat -c %i-%Y "$tmp/grid/runs/00003/summary.json")" == "$stamp" ]] || fail "a finished point was rewritten"
 [[ $(tail -n +2 "$tmp/grid/sweep.csv" | wc -l) -eq 6 ]] || fail "rerun table does not have 6 rows"
 # A different grid into the same folder is refused.
 rc=0; "$conform" sweep arm-track --grid arm.kp=0.3 "${short[@]}" --out "$tmp/grid" 2> "$tmp/err" > /dev/null || rc=$?
 [[ $rc -eq 2 ]] && grep -q "holds another sweep" "$tmp/err" || fail "another sweep into the same folder was not refused"
 
 # --- an injected failing point: reported, the others complete ---------------------------------
-# Point 1's frames folder is a file: its `conform run` fails to create it (exit 1).
-mkdir -p "$tmp/fail/runs/00001" && touch "$tmp/fail/runs/00001/frames"
+# A cut scene of 10 steps (0.17 s) whose point 1 cuts at 1 s: it parses, and fails when it runs
+# ("the event ... is after the last step", exit 1).
+cut=(--steps 10 --set outputs.frames_every=0 --set outputs.plots=false)
 rc=0
-"$conform" sweep arm-track --grid arm.kp=0.3,0.5,0.7 "${short[@]}" --jobs 2 --out "$tmp/fail" \
+"$conform" sweep cut --grid cut.at=0.05,1.0,0.1 "${cut[@]}" --jobs 2 --out "$tmp/fail" \
   > "$tmp/fail.log" 2>&1 || rc=$?
 [[ $rc -eq 1 ]] || { cat "$tmp/fail.log" >&2; fail "a sweep with a failed point should exit 1, not $rc"; }
-grep -q "failed: point 1 (arm.kp=0.5): exit 1: .*cannot create .*frames" "$tmp/fail.log" ||
+grep -q "failed: point 1 (cut.at=1.0): exit 1: .*is after the last step" "$tmp/fail.log" ||
   { cat "$tmp/fail.log" >&2; fail "the failure is not reported with its error"; }
 python3 - "$tmp/fail" <<'PY' || fail "failure table is wrong"
-import csv, sys
-rows = list(csv.DictReader(open(sys.argv[1] + "/sweep.csv")))
+import csv, json, sys, os
+d = sys.argv[1]
+rows = list(csv.DictReader(open(d + "/sweep.csv")))
 assert [r["status"] for r in rows] == ["ok", "failed", "ok"], [r["status"] for r in rows]
-assert rows[1]["exit_code"] == "1" and "cannot create" in rows[1]["error"] and rows[1]["metrics.rms_error"] == ""
-assert rows[1]["seed"] == "7"
-assert all(float(rows[i]["metrics.rms_error"]) > 0 for i in (0, 2))
+assert rows[1]["exit_code"] == "1" and "after the last step" in rows[1]["error"]
+assert rows[1]["metrics.offset_max"] == "" and rows[1]["seed"] == "1"
+assert all(float(rows[i]["metrics.offset_max"]) > 0 for i in (0, 2))
+assert not os.path.exists(d + "/runs/00001")  # a failed run leaves no folder
+status = json.load(open(d + "/runs/00001.status.json"))
+assert status["exit_code"] == 1 and "after the last step" in status["error"]
+assert "after the last step" in open(d + "/runs/00001.err").read()
 PY
-# Fixed, the rerun runs only the failed point and the sweep completes.
-rm "$tmp/fail/runs/00001/frames"
-"$conform" sweep arm-track --grid arm.kp=0.3,0.5,0.7 "${short[@]}" --out "$tmp/fail" > "$tmp/fail2.log" 2>&1 ||
-  { cat "$tmp/fail2.log" >&2; fail "the fixed rerun failed"; }
-grep -q "2 of 3 points already finished" "$tmp/fail2.log" || fail "the fixed rerun did not skip the finished points"
+# A rerun retries the failed point only.
+rc=0
+"$conform" sweep cut --grid cut.at=0.05,1.0,0.1 "${cut[@]}" --out "$tmp/fail" > "$tmp/fail2.log" 2>&1 || rc=$?
+[[ $rc -eq 1 ]] || fail "the rerun should fail again"
+grep -q "2 of 3 points already finished" "$tmp/fail2.log" || { cat "$tmp/fail2.log" >&2; fail "the rerun did not skip the finished points"; }
+grep -q "^sweep: point 1 (cut.at=1.0) FAILED" "$tmp/fail2.log" || fail "the rerun did not retry the failed point"
 
 # --- --zip and --repeat -------------------------------------------------------------------------
 "$conform" sweep arm-track --zip arm.kp=0.3,0.5 --zip physics.substeps=1,2 --repeat 2 "${short[@]}" \
@@ -185,6 +192,8 @@ expect_refused "key '--time', value \"10 minutes\": must be one word" --grid arm
 expect_refused "key '--time', value 1:2:3:4: is not a Slurm time" --grid arm.kp=0.3 --slurm --time 1:2:3:4
 rc=0; "$conform" sweep --task 9 "$tmp/task" 2> "$tmp/err" || rc=$?
 [[ $rc -eq 2 ]] && grep -q "is not a point of this sweep (0..3)" "$tmp/err" || fail "--task 9 was not refused"
+rc=0; "$conform" sweep --gather "$tmp/task" --grid arm.kp=1 2> "$tmp/err" || rc=$?
+[[ $rc -eq 2 ]] && grep -q "takes only the sweep folder" "$tmp/err" || fail "--gather with a grid was not refused"
 rc=0; "$conform" sweep --gather "$tmp/nothing" 2> "$tmp/err" || rc=$?
 [[ $rc -eq 2 ]] && grep -q "sweep.json: cannot read" "$tmp/err" || fail "--gather of a non-sweep was not refused"
 echo "sweep_test: ok"
