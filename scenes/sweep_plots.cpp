@@ -60,7 +60,7 @@ std::vector<std::string> plot_metrics(const SweepSpec& spec) {
 namespace {
 
 // The lines of `metric` against axis `x`: keyed by the other axes' values.
-std::map<std::string, Line> lines_of(const SweepTable& table, std::size_t x,
+std::map<std::string, Line> lines_of(const SweepSpec& spec, const SweepTable& table, std::size_t x,
                                      const std::string& metric) {
   std::map<std::string, Line> lines;
   for (const auto& r : table.rows) {
@@ -69,7 +69,8 @@ std::map<std::string, Line> lines_of(const SweepTable& table, std::size_t x,
     if (!y || !numeric(r.point->values[x].second, xv)) continue;
     std::string others;
     for (std::size_t a = 0; a < r.point->values.size(); ++a)
-      if (a != x)
+      // Zipped axes move with x: they label points of one line, not lines.
+      if (a != x && !(spec.axes[x].zipped && spec.axes[a].zipped))
         others += (others.empty() ? "" : ", ") + r.point->values[a].first + " = " +
                   r.point->values[a].second;
     auto& [sum, n] = lines[others.empty() ? "all runs" : others][xv];
@@ -92,7 +93,7 @@ Plot sweep_plot(const SweepSpec& spec, const SweepTable& table, std::size_t x,
   plot.ylabel = literal(metric) +
                 (spec.repeat > 1 ? " (mean of " + std::to_string(spec.repeat) + " seeds)" : "");
   int n = 0;
-  for (const auto& [title, line] : lines_of(table, x, metric)) {
+  for (const auto& [title, line] : lines_of(spec, table, x, metric)) {
     const std::string data = "data/" + plot.name + "_" + std::to_string(n++) + ".csv";
     std::ofstream out(plots_dir / data);
     out << "x,y\n";

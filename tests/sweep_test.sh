@@ -118,6 +118,17 @@ assert got == [("0.3", "1", "0", "1"), ("0.3", "1", "1", "2"), ("0.5", "2", "0",
 PY
 [[ -s "$tmp/zip/plots/rms_error_vs_arm_kp.png" && ! -e "$tmp/zip/plots/max_error_vs_arm_kp.png" ]] ||
   fail "--plot rms_error should draw rms_error only"
+# The zipped keys move together: one line of 2 points (the mean of 2 seeds each).
+[[ $(ls "$tmp/zip/plots/data/rms_error_vs_arm_kp_"*.csv | wc -l) -eq 1 &&
+   $(wc -l < "$tmp/zip/plots/data/rms_error_vs_arm_kp_0.csv") -eq 3 ]] || fail "zipped plot should be one line of 2 points"
+python3 - "$tmp/zip" <<'PY' || fail "the plotted point is not the mean of the repeats"
+import csv, sys
+d = sys.argv[1]
+rows = [r for r in csv.DictReader(open(d + "/sweep.csv")) if r["arm.kp"] == "0.3"]
+pts = list(csv.DictReader(open(d + "/plots/data/rms_error_vs_arm_kp_0.csv")))
+mean = sum(float(r["metrics.rms_error"]) for r in rows) / 2
+assert abs(float(pts[0]["y"]) - mean) <= 1e-8 * mean, (pts, mean)
+PY
 grep -q "plot not drawn: no_such_metric: not a numeric metric of these runs (known: .*rms_error" "$tmp/zip.log" ||
   { cat "$tmp/zip.log" >&2; fail "a misspelt --plot metric is not reported"; }
 
