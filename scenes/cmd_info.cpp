@@ -58,6 +58,7 @@ void register_info(CLI::App& app, Context& context) {
   options->isolate = true;  // a corrupt file must not kill or corrupt the command
   cmd->add_option("MODEL", *model, "model file (any format assimp reads) or arm[:N]");
   add_strict_weights(cmd, options->strict_weights);
+  add_import_limits(cmd, options->isolation);
   cmd->callback([&context, model, options]() {
     if (model->empty()) {
       std::cout << "conform " << conform::version() << "\n"

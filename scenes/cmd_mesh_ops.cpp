@@ -43,6 +43,7 @@ struct Common {
   std::string animation = "0";
   double time = 0;
   bool posed = false;  // --time given
+  io::IsolationLimits import_limits;
 };
 
 void add_common(CLI::App* cmd, Common& c) {
@@ -51,6 +52,7 @@ void add_common(CLI::App* cmd, Common& c) {
   cmd->add_option("--format", c.format, "ply (binary), ply-ascii or obj")
       ->check(CLI::IsMember({"ply", "ply-ascii", "obj"}));
   add_strict_weights(cmd, c.strict_weights);
+  add_import_limits(cmd, c.import_limits);
   cmd->add_option(
       "--animation", c.animation,
       "with --time: the animation to pose the model with, by name or index (default 0)");
@@ -91,6 +93,7 @@ mesh::SkinnedMesh load(const Common& c, nlohmann::json& summary) {
   io::ImportOptions options;
   options.strict_weights = c.strict_weights;
   options.isolate = true;  // a corrupt file must not kill or corrupt the command
+  options.isolation = c.import_limits;
   io::SkinnedModel model = io::load_model(c.model, options);
   for (const auto& w : model.warnings)
     std::cerr << "warning: " << model.source << ": " << w << "\n";

@@ -8,10 +8,10 @@
 #include <memory>
 
 #include "commands.hpp"
-#include "model_pose.hpp"
 #include "conform/io/import.hpp"
 #include "conform/io/mesh_export.hpp"
 #include "conform/skin/skinner.hpp"
+#include "model_pose.hpp"
 
 namespace conform::cli {
 namespace {
@@ -23,6 +23,7 @@ struct SkinArgs {
   int max_influences = 4;
   int threads = 0;
   bool strict_weights = false;
+  io::IsolationLimits import_limits;
 };
 
 using Clock = std::chrono::steady_clock;
@@ -67,6 +68,7 @@ int run_skin(const SkinArgs& a, bool has_time, bool has_frames) {
   io::ImportOptions import_options;
   import_options.strict_weights = a.strict_weights;
   import_options.isolate = true;  // a corrupt file must not kill or corrupt the command
+  import_options.isolation = a.import_limits;
   io::SkinnedModel model = io::load_model(a.model, import_options);
   const double load_ms = ms_since(t0);
   for (const auto& w : model.warnings)
@@ -140,6 +142,7 @@ void register_skin(CLI::App& app, Context& context) {
                   "largest influences used per vertex (default 4)");
   cmd->add_option("--threads", args->threads, "OpenMP threads (default: all)");
   add_strict_weights(cmd, args->strict_weights);
+  add_import_limits(cmd, args->import_limits);
   cmd->add_option("--out", args->out, "output .ply or .obj (with --frames: name_0000.ext, ...)")
       ->required();
   cmd->callback([&context, args, time, frames]() {

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "conform/io/isolation_limits.hpp"
+
 namespace conform::cli {
 
 struct Context {
@@ -27,6 +29,19 @@ inline void add_strict_weights(CLI::App* cmd, bool& strict) {
   cmd->add_flag("--strict-weights", strict,
                 "refuse a model whose bone weights do not sum to 1 (default: normalize them "
                 "with one warning)");
+}
+
+/// --import-seconds, --import-memory: the caps of the isolated import (io::IsolationLimits) on
+/// every command that loads a model file.
+inline void add_import_limits(CLI::App* cmd, io::IsolationLimits& limits) {
+  cmd->add_option("--import-seconds", limits.seconds,
+                  "give up reading the model file after this many seconds (default 30)")
+      ->check(CLI::Range(0.001, 86400.0));
+  cmd->add_option_function<double>(
+         "--import-memory",
+         [&limits](double mib) { limits.memory_bytes = static_cast<std::size_t>(mib * 1048576.0); },
+         "memory cap of the model file's reader, MiB (default 4096)")
+      ->check(CLI::Range(16.0, 1048576.0));
 }
 
 /// The scene `conform` runs when given no arguments.

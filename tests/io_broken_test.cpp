@@ -247,6 +247,25 @@ TEST(IoBroken, TwentyThousandNodeChainImports) {
   EXPECT_NEAR(m.mesh.current(0, 1), 1.0, 1e-12);
 }
 
+// Mutants of the campaign (scripts/fuzz_models.py) on which assimp 5.2's PLY and SMD readers
+// spin forever: the isolated import stops them at its time cap with an error saying so.
+TEST(IoBroken, SpinningReadersStopAtTheTimeCap) {
+  conform::io::ImportOptions o;
+  o.isolate = true;
+  o.isolation.seconds = 0.5;
+  for (const char* f : {"cube_uv_reader_spins.ply", "triangle_reader_spins.smd"}) {
+    const std::string path = kBroken + f;
+    try {
+      conform::io::import_model(path, o);
+      ADD_FAILURE() << f << " imported";
+    } catch (const ImportError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(path, 0), 0u) << e.what();
+      EXPECT_NE(std::string(e.what()).find("did not finish within 0.5 s"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 // A FIFO given as a model is refused at once instead of blocking in open().
 TEST(IoBroken, FifoIsRefused) {
   const auto fifo = std::filesystem::temp_directory_path() /

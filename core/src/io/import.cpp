@@ -580,11 +580,13 @@ ImportError isolation_error(const std::string& file, const Isolated& r,
       [[fallthrough]];  // assimp caught std::bad_alloc and reports it as its error
     case S::out_of_memory:
       why << "reading it ran out of memory (the import's cap is " << limits.memory_bytes / 1048576.0
-          << " MiB: ImportOptions::isolation.memory_bytes); the file is corrupt or too large";
+          << " MiB: ImportOptions::isolation.memory_bytes, --import-memory); the file is corrupt "
+             "or too large";
       break;
     case S::timed_out:
       why << "reading it did not finish within " << limits.seconds
-          << " s (ImportOptions::isolation.seconds); the file is corrupt or too large";
+          << " s (ImportOptions::isolation.seconds, --import-seconds); the file is corrupt or too "
+             "large";
       break;
     case S::crashed:
       why << "assimp crashed reading it (" << r.message
