@@ -10,6 +10,8 @@ packages=(
   libcli11-dev nlohmann-json3-dev
   gnuplot-nox  # conform run draws its PNG plots with it
   libcgal-dev  # optional: the cut's caps (constrained Delaunay) and the cut benchmark's CGAL clip
+  f3d xvfb xauth  # conform run's pictures: f3d renders them under a virtual X display (xvfb-run)
+  ffmpeg          # conform run's video of the pictures (run.gif / run.mp4)
 )
 
 missing=()
