@@ -142,6 +142,7 @@ void compose_frame(std::ostream& gp, const std::vector<FrameSnapshot>& frame, co
                 scale.max, scale.label.c_str(), l.sx(x0),
                 l.sy(0.06 * l.height), l.sx(x1), l.sy(0.06 * l.height + 18), byte(kWoundBed[0]),
                 byte(kWoundBed[1]), byte(kWoundBed[2]), l.sx(x0), l.sy(0.06 * l.height - 14));
+  gp << buf;
   // The strip is sampled on [0, 1] and mapped onto the range: '++' over a small range such as
   // [-0.15, 0.15] came out in 8 flat bands.
   std::snprintf(buf, sizeof buf, "plot '++' using 1:2:(%.9g + %.9g * $2) with image notitle\n",
