@@ -1,9 +1,10 @@
 #include "gltf_sequence.hpp"
 
-#include <assimp/scene.h>
+#include <tiny_gltf.h>
 
 #include <algorithm>
-#include <assimp/Exporter.hpp>
+#include <cstdio>
+#include <cstring>
 #include <map>
 #include <stdexcept>
 
@@ -24,63 +25,120 @@ void GltfSequence::add(FrameSnapshot frame) {
 
 namespace {
 
-aiMesh* to_mesh(const FrameSnapshot& f, const ColourScale& scale) {
-  auto* m = new aiMesh;
-  m->mName = f.name + "_" + std::to_string(f.step);
-  m->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
-  const auto nv = static_cast<unsigned>(f.positions.cols());
-  m->mNumVertices = nv;
-  m->mVertices = new aiVector3D[nv];
-  m->mNormals = new aiVector3D[nv];
-  m->mTextureCoords[0] = new aiVector3D[nv];
-  m->mNumUVComponents[0] = 2;
-  m->mColors[0] = new aiColor4D[nv];
-  for (unsigned v = 0; v < nv; ++v) {
-    const auto x = f.positions.col(v), n = f.normals.col(v);
-    m->mVertices[v] = aiVector3D(ai_real(x.x()), ai_real(x.y()), ai_real(x.z()));
-    m->mNormals[v] = aiVector3D(ai_real(n.x()), ai_real(n.y()), ai_real(n.z()));
-    m->mTextureCoords[0][v] = aiVector3D(ai_real(f.uvs(0, v)), ai_real(f.uvs(1, v)), 0);
-    const Rgb c = scale(f.scalar[v]);
-    m->mColors[0][v] = aiColor4D(ai_real(c[0]), ai_real(c[1]), ai_real(c[2]), 1);
+// The model being built: one buffer holding every array, a view and an accessor per array.
+struct Builder {
+  tinygltf::Model model;
+
+  int view(const void* data, std::size_t bytes, int target) {
+    auto& buf = model.buffers.front().data;
+    while (buf.size() % 4) buf.push_back(0);  // accessors must be aligned to their component
+    tinygltf::BufferView v;
+    v.buffer = 0;
+    v.byteOffset = buf.size();
+    v.byteLength = bytes;
+    v.target = target;
+    const auto* p = static_cast<const unsigned char*>(data);
+    buf.insert(buf.end(), p, p + bytes);
+    model.bufferViews.push_back(v);
+    return static_cast<int>(model.bufferViews.size() - 1);
   }
-  m->mNumFaces = static_cast<unsigned>(f.faces.size());
-  m->mFaces = new aiFace[m->mNumFaces];
-  for (unsigned i = 0; i < m->mNumFaces; ++i) {
-    aiFace& face = m->mFaces[i];
-    face.mNumIndices = 3;
-    face.mIndices = new unsigned[3];
-    for (int k = 0; k < 3; ++k)
-      face.mIndices[k] = static_cast<unsigned>(f.faces[i][static_cast<std::size_t>(k)]);
+
+  // Floats, `width` per element (1, 2, 3 or 4); with bounds (required for POSITION and inputs).
+  int floats(const std::vector<float>& data, int width, int target, bool bounds) {
+    tinygltf::Accessor a;
+    a.bufferView = view(data.data(), data.size() * sizeof(float), target);
+    a.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+    a.count = data.size() / static_cast<std::size_t>(width);
+    a.type = width == 1   ? TINYGLTF_TYPE_SCALAR
+             : width == 2 ? TINYGLTF_TYPE_VEC2
+             : width == 3 ? TINYGLTF_TYPE_VEC3
+                          : TINYGLTF_TYPE_VEC4;
+    if (bounds && a.count > 0) {
+      a.minValues.assign(static_cast<std::size_t>(width), 1e300);
+      a.maxValues.assign(static_cast<std::size_t>(width), -1e300);
+      for (std::size_t i = 0; i < data.size(); ++i) {
+        auto& lo = a.minValues[i % static_cast<std::size_t>(width)];
+        auto& hi = a.maxValues[i % static_cast<std::size_t>(width)];
+        lo = std::min(lo, double(data[i]));
+        hi = std::max(hi, double(data[i]));
+      }
+    }
+    model.accessors.push_back(a);
+    return static_cast<int>(model.accessors.size() - 1);
   }
-  m->mMaterialIndex = 0;
-  return m;
+
+  int indices(const std::vector<std::uint32_t>& data) {
+    tinygltf::Accessor a;
+    a.bufferView = view(data.data(), data.size() * sizeof(std::uint32_t),
+                        TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    a.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+    a.count = data.size();
+    a.type = TINYGLTF_TYPE_SCALAR;
+    model.accessors.push_back(a);
+    return static_cast<int>(model.accessors.size() - 1);
+  }
+};
+
+int add_mesh(Builder& b, const FrameSnapshot& f, const ColourScale& scale) {
+  const auto nv = static_cast<std::size_t>(f.positions.cols());
+  std::vector<float> x(3 * nv), n(3 * nv), uv(2 * nv), c(4 * nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    const auto i = static_cast<Eigen::Index>(v);
+    for (int k = 0; k < 3; ++k) {
+      x[3 * v + std::size_t(k)] = float(f.positions(k, i));
+      n[3 * v + std::size_t(k)] = float(f.normals(k, i));
+    }
+    uv[2 * v] = float(f.uvs(0, i));
+    uv[2 * v + 1] = float(f.uvs(1, i));
+    const Rgb rgb = scale(f.scalar[v]);
+    c[4 * v] = float(rgb[0]), c[4 * v + 1] = float(rgb[1]), c[4 * v + 2] = float(rgb[2]);
+    c[4 * v + 3] = 1;
+  }
+  std::vector<std::uint32_t> idx;
+  idx.reserve(3 * f.faces.size());
+  for (const auto& face : f.faces)
+    for (const auto v : face) idx.push_back(static_cast<std::uint32_t>(v));
+  tinygltf::Primitive p;
+  p.mode = TINYGLTF_MODE_TRIANGLES;
+  p.material = 0;
+  p.attributes["POSITION"] = b.floats(x, 3, TINYGLTF_TARGET_ARRAY_BUFFER, true);
+  p.attributes["NORMAL"] = b.floats(n, 3, TINYGLTF_TARGET_ARRAY_BUFFER, false);
+  p.attributes["TEXCOORD_0"] = b.floats(uv, 2, TINYGLTF_TARGET_ARRAY_BUFFER, false);
+  p.attributes["COLOR_0"] = b.floats(c, 4, TINYGLTF_TARGET_ARRAY_BUFFER, false);
+  p.indices = b.indices(idx);
+  tinygltf::Mesh m;
+  char step[16];
+  std::snprintf(step, sizeof step, "_%06d", f.step);
+  m.name = f.name + step;  // as the PLY frame: frames/NAME_STEP.ply
+  m.primitives.push_back(p);
+  b.model.meshes.push_back(m);
+  return static_cast<int>(b.model.meshes.size() - 1);
 }
 
-// Scale keys that show a node over [from, to) and hide it otherwise; `to` < 0: to the end.
-// glTF's key times must increase strictly, so a step is two keys kEpsilon apart.
-aiNodeAnim* visibility(const std::string& node, double from, double to) {
-  constexpr double kEpsilon = 1e-4;  // s
-  std::vector<std::pair<double, double>> keys;
-  if (from > 2 * kEpsilon) keys.push_back({0, 0}), keys.push_back({from - kEpsilon, 0});
-  keys.push_back({from, 1});
-  if (to > from + 2 * kEpsilon) keys.push_back({to - kEpsilon, 1}), keys.push_back({to, 0});
-  auto* ch = new aiNodeAnim;
-  ch->mNodeName = node;
-  ch->mNumScalingKeys = static_cast<unsigned>(keys.size());
-  ch->mScalingKeys = new aiVectorKey[keys.size()];
-  for (std::size_t i = 0; i < keys.size(); ++i) {
-    const auto s = ai_real(keys[i].second);
-    ch->mScalingKeys[i] = aiVectorKey(keys[i].first, aiVector3D(s, s, s));
-  }
-  // The exporter writes every kind of key it is given: one still position and rotation.
-  ch->mNumPositionKeys = 1;
-  ch->mPositionKeys = new aiVectorKey[1];
-  ch->mNumRotationKeys = 1;
-  ch->mRotationKeys = new aiQuatKey[1];
-  return ch;
+// STEP keys that show node `node` over [from, to) and hide it before and after (to < 0: shown
+// to the end).
+void add_visibility(Builder& b, tinygltf::Animation& anim, int node, double from, double to) {
+  std::vector<float> times, scales;
+  const auto key = [&](double t, float s) {
+    times.push_back(float(t));
+    scales.insert(scales.end(), {s, s, s});
+  };
+  if (from > 0) key(0, 0);
+  key(from, 1);
+  if (to > from) key(to, 0);
+  tinygltf::AnimationSampler s;
+  s.input = b.floats(times, 1, 0, true);
+  s.output = b.floats(scales, 3, 0, false);
+  s.interpolation = "STEP";
+  anim.samplers.push_back(s);
+  tinygltf::AnimationChannel ch;
+  ch.sampler = static_cast<int>(anim.samplers.size() - 1);
+  ch.target_node = node;
+  ch.target_path = "scale";
+  anim.channels.push_back(ch);
 }
 
-// One row per run name, side by side along x, each row 1.5 widths of the first row's mesh.
+// One row per run name, side by side along x, each row 1.5 widths of the widest mesh.
 std::map<std::string, double> row_offsets(const std::vector<FrameSnapshot>& frames) {
   std::map<std::string, double> offsets;
   double width = 0;
@@ -103,49 +161,43 @@ void GltfSequence::write(const fs::path& path, const std::string& scalar, double
   for (const auto& f : frames_) values.insert(values.end(), f.scalar.begin(), f.scalar.end());
   const ColourScale scale = make_scale(scalar, values, range);
   const auto offsets = row_offsets(frames_);
-  aiScene scene;
-  scene.mRootNode = new aiNode("conform_run");
-  scene.mNumMaterials = 1;
-  scene.mMaterials = new aiMaterial* [1] { new aiMaterial };
-  const aiString material_name("skin");
-  scene.mMaterials[0]->AddProperty(&material_name, AI_MATKEY_NAME);
-  const auto n = static_cast<unsigned>(frames_.size());
-  scene.mNumMeshes = n;
-  scene.mMeshes = new aiMesh*[n];
-  scene.mRootNode->mNumChildren = n;
-  scene.mRootNode->mChildren = new aiNode*[n];
-  auto* anim = new aiAnimation;
-  anim->mName = "sequence";
-  anim->mTicksPerSecond = 1;  // key times in seconds
-  anim->mNumChannels = n;
-  anim->mChannels = new aiNodeAnim*[n];
-  scene.mNumAnimations = 1;
-  scene.mAnimations = new aiAnimation* [1] { anim };
-  for (unsigned i = 0; i < n; ++i) {
+  Builder b;
+  b.model.asset.version = "2.0";
+  b.model.asset.generator = "conform";
+  b.model.buffers.resize(1);
+  tinygltf::Material skin;
+  skin.name = "skin";
+  skin.doubleSided = true;  // through an open wound a viewer sees the skin's inside
+  skin.pbrMetallicRoughness.metallicFactor = 0;
+  skin.pbrMetallicRoughness.roughnessFactor = 0.8;
+  b.model.materials.push_back(skin);
+  tinygltf::Scene scene;
+  tinygltf::Animation anim;
+  anim.name = "sequence";
+  for (std::size_t i = 0; i < frames_.size(); ++i) {
     const FrameSnapshot& f = frames_[i];
-    scene.mMeshes[i] = to_mesh(f, scale);
-    auto* node = new aiNode(scene.mMeshes[i]->mName.C_Str());
-    node->mParent = scene.mRootNode;
-    node->mNumMeshes = 1;
-    node->mMeshes = new unsigned[1]{i};
-    node->mTransformation = aiMatrix4x4::Translation(aiVector3D(ai_real(offsets.at(f.name)), 0, 0),
-                                                     node->mTransformation);
-    scene.mRootNode->mChildren[i] = node;
+    tinygltf::Node node;
+    node.mesh = add_mesh(b, f, scale);
+    node.name = b.model.meshes.back().name;
+    node.translation = {offsets.at(f.name), 0, 0};
+    b.model.nodes.push_back(node);
+    const int id = static_cast<int>(b.model.nodes.size() - 1);
+    scene.nodes.push_back(id);
     // Shown from its own time until the next frame of the same run.
     double next = -1;
     for (const auto& g : frames_)
       if (g.name == f.name && g.time > f.time && (next < 0 || g.time < next)) next = g.time;
-    anim->mChannels[i] = visibility(node->mName.C_Str(), f.time, next);
-    anim->mChannels[i]->mPositionKeys[0] =
-        aiVectorKey(f.time, aiVector3D(ai_real(offsets.at(f.name)), 0, 0));
-    anim->mDuration = std::max(anim->mDuration, f.time);
+    add_visibility(b, anim, id, f.time, next);
   }
+  b.model.scenes.push_back(scene);
+  b.model.defaultScene = 0;
+  b.model.animations.push_back(anim);
   const fs::path tmp = path.parent_path() / ("." + path.filename().string() + ".tmp");
-  Assimp::Exporter exporter;
-  if (exporter.Export(&scene, "glb2", tmp.string()) != aiReturn_SUCCESS) {
+  tinygltf::TinyGLTF writer;
+  if (!writer.WriteGltfSceneToFile(&b.model, tmp.string(), false, true, false, true)) {
     std::error_code ec;
     fs::remove(tmp, ec);
-    throw std::runtime_error("cannot write " + path.string() + ": " + exporter.GetErrorString());
+    throw std::runtime_error("cannot write " + path.string() + " (tinygltf)");
   }
   fs::rename(tmp, path);
 }

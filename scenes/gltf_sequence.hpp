@@ -3,7 +3,9 @@
 // shows the frames in turn by scaling their nodes between 0 and 1 (a common glTF pattern:
 // glTF has no visibility channel). Each run's frames (physics, geometric, ...) form a row of
 // their own, side by side along x. Meshes carry normals, UVs (TEXCOORD_0) and vertex colours
-// (COLOR_0) from the colour scale of the pictures. Written by assimp's glTF 2 exporter.
+// (COLOR_0) from the colour scale of the pictures; vertex i is vertex i of frames/NAME_STEP.ply.
+// Written by tinygltf (Debian's libtinygltf-dev), not assimp's glb2 exporter: that one always
+// joins identical vertices, which zipped up a tear's coincident lips (2 of 2694 vertices gone).
 #pragma once
 
 #include <filesystem>

@@ -12,6 +12,7 @@ packages=(
   libcgal-dev  # optional: the cut's caps (constrained Delaunay) and the cut benchmark's CGAL clip
   f3d xvfb xauth  # conform run's pictures: f3d renders them under a virtual X display (xvfb-run)
   ffmpeg          # conform run's video of the pictures (run.gif / run.mp4)
+  libtinygltf-dev # conform run's run.glb (glTF 2.0 binary)
 )
 
 missing=()
