@@ -139,9 +139,9 @@ void compose_frame(std::ostream& gp, const std::vector<FrameSnapshot>& frame, co
                 "fc rgb '#%02x%02x%02x' fs solid noborder\n"
                 "set label 1 'wound bed' at screen %.6f,screen %.6f\n",
                 l.sx(x0), l.sx(x1), l.sy(0.22 * l.height), l.sy(0.92 * l.height), scale.min,
-                scale.max, scale.label.c_str(), l.sx(x0),
-                l.sy(0.06 * l.height), l.sx(x1), l.sy(0.06 * l.height + 18), byte(kWoundBed[0]),
-                byte(kWoundBed[1]), byte(kWoundBed[2]), l.sx(x0), l.sy(0.06 * l.height - 14));
+                scale.max, scale.label.c_str(), l.sx(x0), l.sy(0.06 * l.height), l.sx(x1),
+                l.sy(0.06 * l.height + 18), byte(kWoundBed[0]), byte(kWoundBed[1]),
+                byte(kWoundBed[2]), l.sx(x0), l.sy(0.06 * l.height - 14));
   gp << buf;
   // The strip is sampled on [0, 1] and mapped onto the range: '++' over a small range such as
   // [-0.15, 0.15] came out in 8 flat bands.
@@ -180,10 +180,11 @@ void warn(Json& report, const std::string& message) {
   report["warnings"].push_back(message);
 }
 
-// Runs the f3d jobs of render.sh, as many at once as there are cores (f3d is single-threaded
-// and spends most of its time starting), under xvfb-run when there is no display.
-bool run_panels(const fs::path& pics, const std::vector<std::string>& jobs, const RenderSettings& r,
-                Json& report) {
+// Starts the f3d jobs of render.sh, as many at once as there are cores (f3d is single-threaded
+// and spends most of its time starting), under xvfb-run when there is no display. Returns the
+// running script (to pclose), or nullptr.
+FILE* launch_panels(const fs::path& pics, const std::vector<std::string>& jobs,
+                    const RenderSettings& r, Json& report) {
   const unsigned cores = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
   {
     std::ofstream sh(pics / "render.sh");
@@ -193,7 +194,7 @@ bool run_panels(const fs::path& pics, const std::vector<std::string>& jobs, cons
       sh << jobs[i] << " &\n" << ((i + 1) % cores == 0 || i + 1 == jobs.size() ? "wait\n" : "");
     if (!sh) {
       warn(report, "cannot write " + (pics / "render.sh").string());
-      return false;
+      return nullptr;
     }
   }
   const char* display = std::getenv("DISPLAY");
@@ -201,16 +202,16 @@ bool run_panels(const fs::path& pics, const std::vector<std::string>& jobs, cons
   if (!display || !*display) {
     if (!have_tool("xvfb-run")) {
       warn(report, "no display and no xvfb-run (scripts/deps.sh installs xvfb): no pictures");
-      return false;
+      return nullptr;
     }
     const int w = std::max(r.width, 1280), h = std::max(r.height, 1024);
     cmd = "xvfb-run -a -s " +
           sq("-screen 0 " + std::to_string(w) + "x" + std::to_string(h) + "x24") + " " + cmd;
   }
   cmd += " > " + sq((pics / "render.log").string()) + " 2>&1";
-  if (std::system(cmd.c_str()) != 0)
-    warn(report, "the render script failed (see " + (pics / "render.log").string() + ")");
-  return true;
+  FILE* running = ::popen(cmd.c_str(), "r");
+  if (!running) warn(report, "cannot start the render script " + (pics / "render.sh").string());
+  return running;
 }
 
 bool compose(const fs::path& pics, const std::vector<std::vector<FrameSnapshot>>& frames,
@@ -271,63 +272,94 @@ Json camera_json(const Camera& c) {
 
 }  // namespace
 
-Json PictureRenderer::finish() {
+struct PictureRenderer::Pending {
   Json report = {{"pictures", Json::array()}, {"warnings", Json::array()}};
-  const auto t0 = Clock::now();
-  if (frames_.empty()) return report;
-  if (!have_tool("f3d")) {
-    warn(report, "f3d is not installed (scripts/deps.sh installs f3d, xvfb, ffmpeg): no pictures");
-    return report;
-  }
+  Clock::time_point t0 = Clock::now(), t_render = Clock::now();
   std::vector<std::vector<FrameSnapshot>> frames;
-  for (const auto i : chosen()) frames.push_back(frames_[i]);
-  std::vector<double> values;
-  for (const auto& f : frames)
-    for (const auto& p : f) values.insert(values.end(), p.scalar.begin(), p.scalar.end());
-  const ColourScale scale = make_scale(settings_.scalar, values, settings_.range);
-  const Camera camera =
-      aim_camera(frames.back(), settings_.camera, double(settings_.width) / settings_.height);
-  const fs::path pics = dir_ / "pictures";
-  fs::create_directories(pics / "panels");
-  std::vector<std::string> jobs;
+  ColourScale scale{};
+  Camera camera{};
+  fs::path pics;
   std::vector<fs::path> inputs;
-  for (const auto& f : frames)
-    for (const auto& p : f) {
-      const std::string s = "panels/" + stem(p.name, p.step);
-      write_panel_ply(pics / (s + ".ply"), p, scale);
-      inputs.push_back(pics / (s + ".ply"));
-      jobs.push_back(f3d_command(s + ".ply", s + ".png", settings_, camera));
+  std::size_t panels = 0;
+  FILE* running = nullptr;
+};
+
+PictureRenderer::~PictureRenderer() {
+  if (pending_ && pending_->running) ::pclose(pending_->running);
+}
+
+void PictureRenderer::start() {
+  started_ = true;
+  pending_ = std::make_unique<Pending>();
+  Pending& p = *pending_;
+  if (frames_.empty()) return;
+  if (!have_tool("f3d")) {
+    warn(p.report,
+         "f3d is not installed (scripts/deps.sh installs f3d, xvfb, ffmpeg): no pictures");
+    return;
+  }
+  for (const auto i : chosen()) p.frames.push_back(frames_[i]);
+  std::vector<double> values;
+  for (const auto& f : p.frames)
+    for (const auto& panel : f)
+      values.insert(values.end(), panel.scalar.begin(), panel.scalar.end());
+  p.scale = make_scale(settings_.scalar, values, settings_.range);
+  p.camera =
+      aim_camera(p.frames.back(), settings_.camera, double(settings_.width) / settings_.height);
+  p.pics = dir_ / "pictures";
+  fs::create_directories(p.pics / "panels");
+  std::vector<std::string> jobs;
+  for (const auto& f : p.frames)
+    for (const auto& panel : f) {
+      const std::string s = "panels/" + stem(panel.name, panel.step);
+      write_panel_ply(p.pics / (s + ".ply"), panel, p.scale);
+      p.inputs.push_back(p.pics / (s + ".ply"));
+      jobs.push_back(f3d_command(s + ".ply", s + ".png", settings_, p.camera));
     }
-  const auto t_render = Clock::now();
-  const bool rendered = run_panels(pics, jobs, settings_, report);
-  const double render_ms = ms_since(t_render);
-  for (const auto& in : inputs) fs::remove(in);
+  p.panels = jobs.size();
+  p.t_render = Clock::now();
+  p.running = launch_panels(p.pics, jobs, settings_, p.report);
+}
+
+Json PictureRenderer::finish() {
+  if (!started_) start();
+  Pending& p = *pending_;
+  Json& report = p.report;
+  if (!p.running) return report;
+  const int rc = ::pclose(p.running);
+  p.running = nullptr;
+  if (rc != 0)
+    warn(report, "the render script failed (see " + (p.pics / "render.log").string() + ")");
+  const double render_ms = ms_since(p.t_render);
+  for (const auto& in : p.inputs) fs::remove(in);
   std::size_t missing = 0;
-  for (const auto& f : frames)
-    for (const auto& p : f) {
-      const fs::path png = pics / "panels" / (stem(p.name, p.step) + ".png");
+  for (const auto& f : p.frames)
+    for (const auto& panel : f) {
+      const fs::path png = p.pics / "panels" / (stem(panel.name, panel.step) + ".png");
       if (!fs::exists(png)) ++missing;
       fs::remove(png.string() + ".log");
     }
-  if (!rendered || missing > 0) {
-    if (rendered) warn(report, std::to_string(missing) + " panels were not rendered");
+  if (missing > 0) {
+    warn(report, std::to_string(missing) + " panels were not rendered (see " +
+                     (p.pics / "render.log").string() + ")");
     return report;
   }
-  fs::remove(pics / "render.log");
+  fs::remove(p.pics / "render.log");
   const auto t_compose = Clock::now();
-  if (compose(pics, frames, settings_, scale, title_, report))
-    for (const auto& f : frames)
+  if (compose(p.pics, p.frames, settings_, p.scale, title_, report))
+    for (const auto& f : p.frames)
       report["pictures"].push_back("pictures/" + stem("step", f.front().step) + ".png");
   const double compose_ms = ms_since(t_compose);
   const auto t_video = Clock::now();
   if (settings_.video != "none" && report["pictures"].size() >= 2)
     make_video(dir_, settings_, report);
-  report["camera"] = camera_json(camera);
-  report["scale"] = {{"scalar", settings_.scalar}, {"min", scale.min}, {"max", scale.max}};
+  report["camera"] = camera_json(p.camera);
+  report["scale"] = {{"scalar", settings_.scalar}, {"min", p.scale.min}, {"max", p.scale.max}};
+  // f3d's wall time includes the plots drawn meanwhile (RunOutput::finish).
   report["timings"] = {
-      {"panels", jobs.size()},    {"f3d_ms_per_panel", render_ms / double(jobs.size())},
-      {"compose_ms", compose_ms}, {"video_ms", ms_since(t_video)},
-      {"total_ms", ms_since(t0)}, {"ms_per_picture", ms_since(t0) / double(frames.size())}};
+      {"panels", p.panels},         {"f3d_ms_per_panel", render_ms / double(p.panels)},
+      {"compose_ms", compose_ms},   {"video_ms", ms_since(t_video)},
+      {"total_ms", ms_since(p.t0)}, {"ms_per_picture", ms_since(p.t0) / double(p.frames.size())}};
   return report;
 }
 

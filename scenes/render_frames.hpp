@@ -18,6 +18,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -35,17 +36,27 @@ class PictureRenderer {
   void add(std::vector<FrameSnapshot> panels);
   std::size_t offered() const { return frames_.size(); }
 
-  /// Renders the chosen frames; returns what was written, timings and warnings (for
-  /// summary.json). Warnings also go to stderr.
+  /// Starts rendering the chosen frames (f3d runs in the background).
+  void start();
+  /// Waits for the renders (starting them if start() was not called), composes the pictures
+  /// and the video; returns what was written, timings and warnings (for summary.json).
+  /// Warnings also go to stderr.
   Json finish();
+
+  PictureRenderer(const PictureRenderer&) = delete;
+  PictureRenderer& operator=(const PictureRenderer&) = delete;
+  ~PictureRenderer();
 
  private:
   std::vector<std::size_t> chosen() const;
+  struct Pending;  // a render under way
 
   RenderSettings settings_;
   std::filesystem::path dir_;
   std::string title_;
   std::vector<std::vector<FrameSnapshot>> frames_;
+  std::unique_ptr<Pending> pending_;
+  bool started_ = false;
 };
 
 /// True when `tool` is on PATH.

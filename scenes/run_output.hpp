@@ -117,8 +117,9 @@ class RunOutput {
 
  private:
   bool draw(const Plot& plot, std::string& problem) const;
-  /// The pictures, the video and run.glb; their report for summary.json.
-  Json finish_render(double loop_seconds, int steps);
+  /// The pictures (started at t0, while plots took plots_ms), the video and run.glb; their
+  /// report for summary.json.
+  Json finish_render(Clock::time_point t0, double plots_ms, double loop_seconds, int steps);
 
   std::filesystem::path dir_;
   CommonSettings common_;
