@@ -20,6 +20,7 @@ struct RunArgs {
   std::string scene, out;
   int steps = 0;
   std::vector<std::string> sets;
+  bool no_render = false;
 };
 
 void print_metrics(const scenes::Json& j, const std::string& prefix) {
@@ -81,7 +82,13 @@ int run_scene(const std::string& scene, const std::string& out_dir, int steps,
           std::cout << "plot " << it.key() << ": " << it->get<std::string>() << "\n";
     }
     std::cout << "results in " << std::filesystem::absolute(dir).lexically_normal().string()
-              << "/ (summary.json, metrics.csv, frames/*.ply, *.png)\n";
+              << "/ (summary.json, metrics.csv, frames/*.ply, *.png"
+              << (summary.is_object() && summary["render"].contains("glb") ? ", run.glb" : "")
+              << (summary.is_object() &&
+                          summary["render"].value("pictures", scenes::Json::array()).size() > 0
+                      ? ", pictures/*.png"
+                      : "")
+              << ")\n";
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "conform run: " << prepared->common().name << ": " << e.what() << "\n";
@@ -99,7 +106,11 @@ void register_run(CLI::App& app, Context& context) {
       ->check(CLI::Range(1, scenes::kMaxSteps));
   cmd->add_option("--set", args->sets, "override a scene key, e.g. --set physics.dt=0.005")
       ->allow_extra_args(false);
+  cmd->add_flag("--no-render", args->no_render,
+                "no pictures, video or run.glb (the scene's \"render\": false)");
   cmd->callback([&context, args]() {
+    // Last, so that it wins over any --set render.KEY=VALUE.
+    if (args->no_render) args->sets.push_back("render=false");
     context.exit_code = run_scene(args->scene, args->out, args->steps, args->sets);
   });
 }

@@ -11,6 +11,8 @@
 #include "conform/bullet/convert.hpp"
 #include "conform/io/mesh_export.hpp"
 #include "conform/version.hpp"
+#include "gltf_sequence.hpp"
+#include "render_frames.hpp"
 
 namespace conform::scenes {
 
@@ -40,6 +42,7 @@ CommonSettings read_common(Reader& root, const std::string& name, double default
   c.frames_every = outputs.integer("frames_every", 0, 0, 1000000);
   c.plots = outputs.boolean("plots", true);
   outputs.finish();
+  c.render = read_render(root);
   // In double first: int(duration / dt) overflowed to a 1-step run that reported success.
   const double steps = std::max(1.0, std::round(duration / c.dt));
   if (steps_override <= 0 && steps > kMaxSteps)
@@ -78,7 +81,12 @@ RunOutput::RunOutput(fs::path dir, const CommonSettings& common)
   if (ec)
     throw std::runtime_error("cannot create " + (dir_ / "frames").string() + ": " + ec.message());
   tty_ = ::isatty(STDERR_FILENO) == 1;
+  if (common_.render.enabled)
+    pictures_ = std::make_unique<PictureRenderer>(common_.render, dir_, common_.name);
+  if (common_.render.glb) gltf_ = std::make_unique<GltfSequence>();
 }
+
+RunOutput::~RunOutput() = default;
 
 void RunOutput::open_metrics(std::vector<std::string> columns) {
   metrics_ = std::make_unique<Csv>(dir_ / "metrics.csv", std::move(columns));
@@ -94,6 +102,45 @@ void RunOutput::frame(const std::string& name, int step, const mesh::SkinnedMesh
   std::snprintf(buf, sizeof buf, "_%06d.ply", step);
   io::write_mesh(dir_ / "frames" / (name + buf), mesh, {}, faces);
   ++frames_;
+  // A piece (a subset of faces) is not a frame of the sequence: its whole mesh is.
+  if (gltf_ && faces.empty())
+    gltf_->add(snapshot(name, step, step * common_.dt, mesh, {}, common_.render.scalar));
+}
+
+void RunOutput::picture(int step, const std::vector<PicturePanel>& panels) {
+  if (!pictures_ && !gltf_) return;
+  std::vector<FrameSnapshot> shots;
+  for (const auto& p : panels)
+    shots.push_back(
+        snapshot(p.name, step, step * common_.dt, *p.mesh, p.lips, common_.render.scalar));
+  if (gltf_)
+    for (const auto& s : shots) gltf_->add(s);
+  if (pictures_) pictures_->add(std::move(shots));
+}
+
+Json RunOutput::finish_render(Clock::time_point t0, double plots_ms, double loop_seconds,
+                              int steps) {
+  Json report = Json::object();
+  if (pictures_) report = pictures_->finish();
+  // What the pictures add to the run's wall time: the plots drawn meanwhile are not theirs.
+  const double pictures_ms = std::max(
+      0.0, std::chrono::duration<double, std::milli>(Clock::now() - t0).count() - plots_ms);
+  if (gltf_ && gltf_->size() > 0) {
+    const auto t1 = Clock::now();
+    gltf_->write(dir_ / "run.glb", common_.render.scalar, common_.render.range);
+    report["glb"] = "run.glb";
+    report["glb_frames"] = gltf_->size();
+    report["glb_ms"] = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+  }
+  // Rendering against simulating, in the same run: one picture against one step.
+  const std::size_t n = report.contains("pictures") ? report["pictures"].size() : 0;
+  const double step_ms = steps > 0 ? 1e3 * loop_seconds / steps : 0.0;
+  report["render_ms_total"] = pictures_ms;
+  report["render_ms_per_picture"] = n > 0 ? pictures_ms / double(n) : 0.0;
+  report["sim_ms_per_step"] = step_ms;
+  report["render_picture_per_sim_step"] =
+      n > 0 && step_ms > 0 ? pictures_ms / double(n) / step_ms : 0.0;
+  return report;
 }
 
 void RunOutput::progress(int step, int steps) {
@@ -198,8 +245,11 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   if (const std::string bad = first_non_finite(metrics, ""); !bad.empty())
     throw std::runtime_error("metric " + bad +
                              " is NaN or infinite: the simulation went non-finite");
-  const double wall = std::chrono::duration<double>(Clock::now() - start_).count();
+  // The renderer's f3d processes run while gnuplot draws the plots (both mostly wait).
+  const auto render_start = Clock::now();
+  if (pictures_) pictures_->start();
   Json plots = Json::object();
+  const auto plots_start = Clock::now();
   if (common_.plots) {
     const bool gnuplot = have_gnuplot();
     for (const auto& p : plots_) {
@@ -210,6 +260,10 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
         plots[p.name] = "not drawn: " + problem;
     }
   }
+  const double plots_ms =
+      std::chrono::duration<double, std::milli>(Clock::now() - plots_start).count();
+  const Json render = finish_render(render_start, plots_ms, loop_seconds, steps);
+  const double wall = std::chrono::duration<double>(Clock::now() - start_).count();
   Json summary;
   summary["scene"] = common_.name;
   summary["kind"] = common_.kind;
@@ -236,6 +290,7 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   summary["metrics"] = metrics;
   summary["frames"] = frames_;
   summary["plots"] = plots;
+  summary["render"] = render;
   const fs::path path = dir_ / "summary.json", tmp = dir_ / ".summary.json.tmp";
   {
     std::ofstream out(tmp);

@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "conform/mesh/skinned_mesh.hpp"
+#include "frame_snapshot.hpp"
+#include "render_settings.hpp"
 #include "scene_config.hpp"
 
 namespace conform::scenes {
@@ -54,7 +56,18 @@ struct CommonSettings {
   int metrics_every = 1;  // steps between metric rows
   int frames_every = 0;   // steps between PLY frames (0: first and last only)
   bool plots = true;
-  int threads = 1;  // OpenMP threads (0: OpenMP's default)
+  int threads = 1;          // OpenMP threads (0: OpenMP's default)
+  RenderSettings render{};  // pictures, video and run.glb (render_settings.hpp)
+};
+
+class PictureRenderer;
+class GltfSequence;
+
+/// One run's surface in a picture: its name (the panel's title), its mesh and its wound.
+struct PicturePanel {
+  std::string name;
+  const mesh::SkinnedMesh* mesh = nullptr;
+  Lips lips{};
 };
 
 class RunOutput {
@@ -63,6 +76,7 @@ class RunOutput {
 
   /// Creates `dir` (and dir/frames). Throws std::runtime_error when it cannot.
   RunOutput(std::filesystem::path dir, const CommonSettings& common);
+  ~RunOutput();
 
   const std::filesystem::path& dir() const { return dir_; }
 
@@ -86,6 +100,10 @@ class RunOutput {
              std::span<const std::int32_t> faces = {});
   int frames_written() const { return frames_; }
 
+  /// Offers a picture of this step: the panels side by side, rendered when the run finishes
+  /// (render_frames.hpp; a no-op with "render": false). Call it beside frame().
+  void picture(int step, const std::vector<PicturePanel>& panels);
+
   /// Progress on stderr, only when it is a terminal.
   void progress(int step, int steps);
 
@@ -98,12 +116,18 @@ class RunOutput {
                                double simulated_seconds, double loop_seconds);
 
  private:
+  /// The pictures (started at t0, while plots took plots_ms), the video and run.glb; their
+  /// report for summary.json.
+  Json finish_render(Clock::time_point t0, double plots_ms, double loop_seconds, int steps);
+
   std::filesystem::path dir_;
   CommonSettings common_;
   Clock::time_point start_;
   std::clock_t cpu_start_;
   std::unique_ptr<Csv> metrics_;
   std::vector<Plot> plots_;
+  std::unique_ptr<PictureRenderer> pictures_;
+  std::unique_ptr<GltfSequence> gltf_;
   int frames_ = 0;
   bool tty_ = false;
   int last_percent_ = -1;

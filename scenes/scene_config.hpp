@@ -45,6 +45,10 @@ class Reader {
   Reader(const Json& object, std::string path, Json& resolved);
 
   bool has(const std::string& key) const { return object_->contains(key); }
+  /// True when the key is present and a boolean (a key that is a switch or an object).
+  bool is_boolean(const std::string& key) const {
+    return has(key) && object_->at(key).is_boolean();
+  }
   double number(const std::string& key, double fallback, double min = -kInf, double max = kInf);
   /// Like number() but the key must be present.
   double required_number(const std::string& key, double min = -kInf, double max = kInf);

@@ -136,6 +136,8 @@ class TearOpening final : public Scene {
         r.body.sync_mesh();
         out.frame("physics", step, r.body.mesh());
         out.frame("geometric", step, r.geo);
+        out.picture(step, {{"physics", &r.body.mesh(), lips(r.body.tear())},
+                           {"geometric", &r.geo, lips(&r.geo_tear)}});
       }
       out.progress(step, c.steps);
     }
@@ -195,6 +197,12 @@ class TearOpening final : public Scene {
     const auto t0 = Clock::now();
     f();
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  }
+
+  // A tear's two borders, the wound the pictures aim at (none before the tear began).
+  static Lips lips(const mesh::Tear* tear) {
+    if (!tear || tear->path_length() < 2) return {};
+    return {tear->left_border(), tear->right_border()};
   }
 
   // The arm with its elbow flexed; both runs start from this posed (skinned) arm.

@@ -11,6 +11,9 @@ packages=(
   gnuplot-nox  # conform run draws its PNG plots with it
   libcgal-dev  # optional: the cut's caps (constrained Delaunay) and the cut benchmark's CGAL clip
   slurmctld slurmd slurm-client munge  # sweep_slurm_test: a one-node Slurm cluster
+  f3d xvfb xauth  # conform run's pictures: f3d renders them under a virtual X display (xvfb-run)
+  ffmpeg          # conform run's video of the pictures (run.gif / run.mp4)
+  libtinygltf-dev # conform run's run.glb (glTF 2.0 binary)
 )
 
 missing=()

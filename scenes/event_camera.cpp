@@ -1,0 +1,80 @@
+#include "event_camera.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <numbers>
+
+namespace conform::scenes {
+
+namespace {
+
+struct Points {
+  Eigen::Matrix3Xd x;      // the event's points (or every vertex)
+  Eigen::Vector3d normal;  // their mean outward normal
+  bool event = false;
+};
+
+Points gather(std::span<const FrameSnapshot> panels) {
+  Eigen::Index n = 0;
+  for (const auto& p : panels) n += static_cast<Eigen::Index>(p.focus.size());
+  Points pts;
+  pts.event = n > 0;
+  if (!pts.event)
+    for (const auto& p : panels) n += p.positions.cols();
+  pts.x.resize(3, n);
+  pts.normal.setZero();
+  Eigen::Index k = 0;
+  for (const auto& p : panels) {
+    if (pts.event) {
+      for (const auto v : p.focus) {
+        pts.x.col(k++) = p.positions.col(v);
+        pts.normal += p.normals.col(v);
+      }
+    } else {
+      pts.x.middleCols(k, p.positions.cols()) = p.positions;
+      k += p.positions.cols();
+    }
+  }
+  return pts;
+}
+
+}  // namespace
+
+Camera aim_camera(std::span<const FrameSnapshot> panels, const RenderCamera& s, double aspect) {
+  Camera c;
+  c.view_angle = s.view_angle;
+  c.how = "event";
+  const Points pts = gather(panels);
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero(), axis = Eigen::Vector3d::UnitZ();
+  double extent = 1;
+  if (pts.x.cols() > 0) {
+    centre = pts.x.rowwise().mean();
+    const Eigen::Matrix3Xd d = pts.x.colwise() - centre;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(d * d.transpose());
+    axis = eig.eigenvectors().col(2);  // the long axis of the wound
+    extent = 2 * d.colwise().norm().maxCoeff();
+  }
+  extent = std::max(extent, 1e-3);
+  Eigen::Vector3d view = pts.normal;  // from the target towards the camera
+  if (!pts.event) {
+    c.how = "mesh";
+    view = Eigen::Vector3d(1, 0.4, 0.8);
+  }
+  if (view.norm() < 1e-9) view = Eigen::Vector3d::UnitX();
+  view.normalize();
+  c.target = s.has_target ? s.target : centre;
+  const double half = std::tan(0.5 * c.view_angle * std::numbers::pi / 180);
+  // The wound lies across the picture (its width is `aspect` times its height).
+  const double distance = s.framing * extent / (2 * half * aspect);
+  c.position = s.has_position ? s.position : Eigen::Vector3d(c.target + distance * view);
+  Eigen::Vector3d up = view.cross(axis);
+  if (up.norm() < 1e-6) up = view.unitOrthogonal();
+  up.normalize();
+  if (up.y() < 0) up = -up;  // of the two, the one nearer the world's up
+  c.up = s.has_up ? s.up.normalized() : up;
+  if (s.has_target || s.has_position || s.has_up) c.how = "scene";
+  return c;
+}
+
+}  // namespace conform::scenes

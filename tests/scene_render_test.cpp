@@ -1,0 +1,246 @@
+// `conform run`'s pictures, video and run.glb, on a short tear-opening (60 steps: the stroke
+// and its first opening, frames at steps 0, 30, 60): the pictures have the requested size and
+// show something, the physics and geometric panels differ where the wound is, the wound bed's
+// colour shows through the open wound only once it is open, run.glb reads back through assimp
+// with each frame's vertex and face counts of the PLY frames (read by assimp too), and f3d opens
+// it. A run without f3d on PATH still succeeds, with a warning. The renders need f3d, xvfb and
+// ffmpeg (scripts/deps.sh); conform starts xvfb-run itself when there is no display.
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <assimp/Importer.hpp>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+constexpr int kWidth = 200, kHeight = 150;
+
+const fs::path& run_dir() {
+  // One folder per process: ctest runs each test in its own process, maybe in parallel.
+  static const fs::path dir =
+      fs::temp_directory_path() / ("conform_scene_render_test_" + std::to_string(::getpid()));
+  return dir;
+}
+
+int run_conform(const std::string& args, const fs::path& out, const std::string& env = "") {
+  const fs::path conform = fs::path(CONFORM_BINARY_DIR) / "scenes" / "conform";
+  fs::remove_all(out);
+  const std::string cmd = env + " " + conform.string() + " run tear-opening --steps 60 --out " +
+                          out.string() + " " + args + " > " + out.string() + ".log 2>&1";
+  return std::system(cmd.c_str());
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A PNG's size from its IHDR chunk (bytes 16-23, big-endian).
+std::array<int, 2> png_size(const fs::path& p) {
+  const std::string s = read_text(p);
+  if (s.size() < 24 || s.compare(1, 3, "PNG") != 0) return {0, 0};
+  const auto be = [&](std::size_t at) {
+    int v = 0;
+    for (std::size_t i = 0; i < 4; ++i) v = (v << 8) | static_cast<unsigned char>(s[at + i]);
+    return v;
+  };
+  return {be(16), be(20)};
+}
+
+// The pixels as RGB bytes, decoded by ffmpeg (an independent decoder).
+std::vector<unsigned char> pixels(const fs::path& p) {
+  const std::string cmd =
+      "ffmpeg -loglevel error -i " + p.string() + " -f rawvideo -pix_fmt rgb24 -";
+  std::vector<unsigned char> out;
+  FILE* f = popen(cmd.c_str(), "r");
+  if (!f) return out;
+  unsigned char buf[65536];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;)
+    out.insert(out.end(), buf, buf + n);
+  pclose(f);
+  return out;
+}
+
+// Pixels that are not the white background.
+int foreground(const std::vector<unsigned char>& rgb) {
+  int n = 0;
+  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3) n += rgb[i] + rgb[i + 1] + rgb[i + 2] < 720;
+  return n;
+}
+
+// Pixels of the wound bed's dark crimson (lit, about (99, 41, 53): red well above green and
+// blue, not bright).
+int wound_bed(const std::vector<unsigned char>& rgb) {
+  int n = 0;
+  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3) {
+    const int r = rgb[i], g = rgb[i + 1], b = rgb[i + 2];
+    n += r > 60 && r < 200 && g < 80 && r > g + 35 && r > b + 30;
+  }
+  return n;
+}
+
+class SceneRender : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    rc_ = run_conform("--set render.width=" + std::to_string(kWidth) +
+                          " --set render.height=" + std::to_string(kHeight) +
+                          " --set render.pictures=2 --set outputs.plots=false",
+                      run_dir());
+    summary_ = Json::parse(read_text(run_dir() / "summary.json"), nullptr, false);
+  }
+  static void TearDownTestSuite() {
+    std::error_code ec;
+    fs::remove_all(run_dir(), ec);
+    fs::remove(run_dir().string() + ".log", ec);
+  }
+  static int rc_;
+  static Json summary_;
+};
+int SceneRender::rc_ = -1;
+Json SceneRender::summary_;
+
+TEST_F(SceneRender, RunSucceedsAndReportsItsRenders) {
+  ASSERT_EQ(rc_, 0) << read_text(run_dir().string() + ".log");
+  ASSERT_TRUE(summary_.is_object());
+  const Json& r = summary_["render"];
+  EXPECT_TRUE(r["warnings"].empty()) << r["warnings"].dump();
+  EXPECT_EQ(r["pictures"], Json::array({"pictures/step_000030.png", "pictures/step_000060.png"}));
+  EXPECT_EQ(r["video"], "run.gif");
+  EXPECT_EQ(r["camera"]["aimed_at"], "event");
+  EXPECT_GT(r["render_ms_per_picture"].get<double>(), 0);
+  EXPECT_GT(r["sim_ms_per_step"].get<double>(), 0);
+}
+
+TEST_F(SceneRender, PicturesHaveTheRequestedSizeAndShowTheWound) {
+  ASSERT_EQ(rc_, 0);
+  for (const char* step : {"000030", "000060"}) {
+    const fs::path side = run_dir() / "pictures" / ("step_" + std::string(step) + ".png");
+    // Two panels, the colour bar's 170 px and the titles' 60 px.
+    EXPECT_EQ(png_size(side), (std::array<int, 2>{2 * kWidth + 170, kHeight + 60})) << side;
+    for (const char* run : {"physics", "geometric"}) {
+      const fs::path panel =
+          run_dir() / "pictures" / "panels" / (std::string(run) + "_" + step + ".png");
+      EXPECT_EQ(png_size(panel), (std::array<int, 2>{kWidth, kHeight})) << panel;
+      const auto rgb = pixels(panel);
+      ASSERT_EQ(rgb.size(), std::size_t(3 * kWidth * kHeight)) << panel;
+      // The arm fills a good part of the frame, not all of it.
+      EXPECT_GT(foreground(rgb), kWidth * kHeight / 5) << panel;
+      EXPECT_LT(foreground(rgb), kWidth * kHeight) << panel;
+    }
+  }
+  // At step 30 the stroke has only begun; at step 60 both wounds are open and the wound bed
+  // shows through them.
+  const auto p30 = pixels(run_dir() / "pictures/panels/physics_000030.png");
+  const auto p60 = pixels(run_dir() / "pictures/panels/physics_000060.png");
+  const auto g60 = pixels(run_dir() / "pictures/panels/geometric_000060.png");
+  EXPECT_LT(wound_bed(p30), 20);
+  EXPECT_GT(wound_bed(p60), 100);
+  EXPECT_GT(wound_bed(g60), 50);
+  // Physics and geometric differ, and where they differ is the wound: near the centre.
+  ASSERT_EQ(p60.size(), g60.size());
+  int differ_centre = 0, differ_edge = 0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) {
+      const std::size_t i = 3 * std::size_t(y * kWidth + x);
+      const int d = std::abs(p60[i] - g60[i]) + std::abs(p60[i + 1] - g60[i + 1]) +
+                    std::abs(p60[i + 2] - g60[i + 2]);
+      const bool centre = std::abs(y - kHeight / 2) < kHeight / 6;
+      if (d > 60) ++(centre ? differ_centre : differ_edge);
+    }
+  EXPECT_GT(differ_centre, 100);
+  EXPECT_GT(differ_centre, differ_edge);
+}
+
+TEST_F(SceneRender, VideoIsAGif) {
+  ASSERT_EQ(rc_, 0);
+  EXPECT_EQ(read_text(run_dir() / "run.gif").substr(0, 6), "GIF89a");
+}
+
+TEST_F(SceneRender, GlbRoundTripsThroughAssimpFrameByFrame) {
+  ASSERT_EQ(rc_, 0);
+  Assimp::Importer glb;
+  const aiScene* s = glb.ReadFile((run_dir() / "run.glb").string(), 0);
+  ASSERT_NE(s, nullptr) << glb.GetErrorString();
+  // Frames: physics at 0, 30, 60 and geometric at 30, 60, as the PLY frames.
+  const std::vector<std::string> frames{"physics_000000", "physics_000030", "physics_000060",
+                                        "geometric_000030", "geometric_000060"};
+  ASSERT_EQ(s->mNumMeshes, frames.size());
+  ASSERT_EQ(s->mNumAnimations, 1u);
+  EXPECT_EQ(s->mAnimations[0]->mNumChannels, frames.size());
+  std::vector<unsigned> vertices;
+  for (const auto& name : frames) {
+    // Each frame is a node of its name holding one mesh.
+    const aiNode* node = s->mRootNode->FindNode(name.c_str());
+    ASSERT_NE(node, nullptr) << name;
+    ASSERT_EQ(node->mNumMeshes, 1u) << name;
+    const aiMesh* m = s->mMeshes[node->mMeshes[0]];
+    EXPECT_TRUE(m->HasNormals());
+    EXPECT_TRUE(m->HasTextureCoords(0));
+    EXPECT_TRUE(m->HasVertexColors(0));
+    Assimp::Importer ply;
+    const aiScene* f = ply.ReadFile((run_dir() / "frames" / (name + ".ply")).string(), 0);
+    ASSERT_NE(f, nullptr) << name << ": " << ply.GetErrorString();
+    EXPECT_EQ(m->mNumVertices, f->mMeshes[0]->mNumVertices) << name;
+    // Vertex by vertex the PLY's position (float in the glb).
+    double worst = 0;
+    for (unsigned v = 0; v < m->mNumVertices; ++v)
+      worst = std::max(worst, double((m->mVertices[v] - f->mMeshes[0]->mVertices[v]).Length()));
+    EXPECT_LT(worst, 1e-6) << name;
+    EXPECT_EQ(m->mNumFaces, f->mMeshes[0]->mNumFaces) << name;
+    vertices.push_back(m->mNumVertices);
+  }
+  // The frames are of different meshes: the tear added vertices.
+  EXPECT_LT(vertices[0], vertices[2]);
+}
+
+TEST_F(SceneRender, F3dOpensTheGlb) {
+  ASSERT_EQ(rc_, 0);
+  const fs::path png = run_dir() / "glb.png";
+  const std::string cmd = "xvfb-run -a f3d --dry-run --quiet " + (run_dir() / "run.glb").string() +
+                          " --output " + png.string() +
+                          " --resolution 160,120 --camera-azimuth-angle 90 > /dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const auto rgb = pixels(png);
+  ASSERT_EQ(rgb.size(), std::size_t(3 * 160 * 120));
+  // f3d's default background is dark grey (0.2): count what is not.
+  int lit = 0;
+  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3) lit += std::abs(rgb[i] - 51) > 20;
+  EXPECT_GT(lit, 160 * 120 / 50);
+}
+
+TEST(SceneRenderOff, NoRenderWritesNoPicturesAndNoGlb) {
+  const fs::path out =
+      fs::temp_directory_path() / ("conform_scene_render_off_" + std::to_string(::getpid()));
+  ASSERT_EQ(run_conform("--no-render --set outputs.plots=false", out), 0);
+  EXPECT_FALSE(fs::exists(out / "pictures"));
+  EXPECT_FALSE(fs::exists(out / "run.glb"));
+  EXPECT_TRUE(fs::exists(out / "frames" / "physics_000060.ply"));
+}
+
+TEST(SceneRenderOff, MissingF3dIsAWarningNotAFailure) {
+  const fs::path out =
+      fs::temp_directory_path() / ("conform_scene_render_nof3d_" + std::to_string(::getpid()));
+  // A PATH with nothing on it: no f3d (nor gnuplot); the shell is called by its full path.
+  ASSERT_EQ(run_conform("--set outputs.plots=false", out, "env PATH=/nonexistent"), 0);
+  const std::string log = read_text(out.string() + ".log");
+  EXPECT_NE(log.find("warning: f3d is not installed"), std::string::npos) << log;
+  const Json s = Json::parse(read_text(out / "summary.json"), nullptr, false);
+  ASSERT_TRUE(s.is_object());
+  EXPECT_TRUE(s["render"]["pictures"].empty());
+  EXPECT_TRUE(fs::exists(out / "run.glb"));  // assimp needs no tool
+}
+
+}  // namespace
