@@ -70,7 +70,22 @@ void SkinDrive::rebuild_inputs(const mesh::SkinnedMesh& mesh) {
 void SkinDrive::skin(const mesh::SkinnedMesh& mesh, double time) {
   if (target_.size() != static_cast<std::size_t>(mesh.vertex_count())) rebuild_inputs(mesh);
   if (source_) source_(time, pose_);
+  if (pose_.local.size() != skeleton_->joints.size())  // a source's pose of another skeleton
+    throw std::invalid_argument("SkinnedSoftBody: the pose source gave " +
+                                std::to_string(pose_.local.size()) +
+                                " joints at t = " + std::to_string(time) + " s, the skeleton has " +
+                                std::to_string(skeleton_->joints.size()));
   skinner_->skin(pose_, skin::SkinMode::cga, target_);
+}
+
+void SkinDrive::extend(const mesh::SkinnedMesh& mesh) {
+  if (target_.size() == static_cast<std::size_t>(mesh.vertex_count())) return;
+  const std::size_t old = target_.size();
+  rebuild_inputs(mesh);
+  skinner_->skin(pose_, skin::SkinMode::cga, target_);
+  for (std::size_t v = old; v < target_.size(); ++v)
+    previous_.x[v] = target_.x[v], previous_.y[v] = target_.y[v], previous_.z[v] = target_.z[v];
+  fill_previous_ = false;
 }
 
 void SkinDrive::advance(const mesh::SkinnedMesh& mesh, double time) {
@@ -86,7 +101,9 @@ void SkinDrive::advance(const mesh::SkinnedMesh& mesh, double time) {
 // --- The per-substep drive ---
 
 void SkinnedSoftBody::Impl::update(double dt, double time) {
+  if (!lost_.empty()) throw std::logic_error("SkinnedSoftBody: cannot step: " + lost_);
   if (!(dt > 0)) return;
+  time_ = time;
   drive_.advance(mesh_, time);
   for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot) {
     // A detached vertex rides its target.
@@ -100,7 +117,7 @@ void SkinnedSoftBody::Impl::update(double dt, double time) {
   }
   for (auto& piece : pieces_) {
     if (!piece) continue;
-    drive_nodes(*piece, dt);
+    if (!piece->released) drive_nodes(*piece, dt);  // a released piece is Bullet's alone
     reapply_rest_lengths(*piece);
   }
 }
@@ -119,7 +136,7 @@ void SkinnedSoftBody::Impl::step_membrane(double dt) {
     previous_matrix_.col(Eigen::Index(v)) << previous.x[v], previous.y[v], previous.z[v];
   }
   for (auto& piece : pieces_) {
-    if (!piece) continue;
+    if (!piece || piece->released) continue;  // released: the membrane leaves it alone
     btSoftBody& body = *piece->body;
     for (int i = 0; i < body.m_nodes.size(); ++i) {
       btSoftBody::Node& node = body.m_nodes[i];
@@ -181,10 +198,17 @@ void SkinnedSoftBody::Impl::skin_targets(double time) {
 }
 
 void SkinnedSoftBody::Impl::set_pinned(std::span<const std::int32_t> vertices) {
+  check_editable("set_pinned");
+  for (const auto v : vertices)
+    if (v < 0 || v >= vertex_count())
+      throw std::invalid_argument("SkinnedSoftBody::set_pinned: vertex " + std::to_string(v) +
+                                  " out of range [0, " + std::to_string(vertex_count()) + ")");
   std::fill(pinned_.begin(), pinned_.end(), 0);
   for (const auto v : vertices) pinned_.at(static_cast<std::size_t>(v)) = 1;
   for (std::int32_t v = 0; v < vertex_count(); ++v) {
     const auto i = static_cast<std::size_t>(v);
+    const std::int32_t p = piece_of_[i];
+    if (p >= 0 && pieces_[static_cast<std::size_t>(p)]->released) continue;  // free for good
     const bool k = pinned_[i] || is_kinematic_by_weight(v);
     if (k == bool(kinematic_[i])) continue;
     kinematic_[i] = k;

@@ -40,6 +40,9 @@ class SkinDrive {
   /// A substep's start: the targets become the previous ones, then skin(time); a vertex added
   /// since gets its target as its previous one (zero target velocity).
   void advance(const mesh::SkinnedMesh& mesh, double time);
+  /// After an edit added vertices: their targets now (the last pose, the source not asked
+  /// again), their previous targets equal to them, so that target(v) is valid at once.
+  void extend(const mesh::SkinnedMesh& mesh);
 
   const skin::SoaPoints<double>& targets() const { return target_; }
   const skin::SoaPoints<double>& previous_targets() const { return previous_; }

@@ -49,6 +49,7 @@ void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
   if (c.bending) refresh_changed_bending();
   refresh_changed_areas(c);
   drop_empty_pieces();
+  refresh_released();
   clear_kept();
   bend_dirty_.clear();
   split_.clear();
@@ -314,7 +315,7 @@ void SkinnedSoftBody::Impl::place_changed_nodes(MirrorContext& c) {
     if (group != mesh::SplitSearch::kOpen) {
       auto& o = c.owner[static_cast<std::size_t>(group)];
       if (o < 0) {
-        new_piece();
+        new_piece(c.open_body);
         o = std::int32_t(pieces_.size()) - 1;
       }
       p = o;

@@ -37,6 +37,7 @@
 #include <span>
 #include <vector>
 
+#include "conform/bullet/piece.hpp"
 #include "conform/cga/plane.hpp"
 #include "conform/membrane/skin_material.hpp"
 #include "conform/membrane/solver.hpp"
@@ -104,6 +105,16 @@ struct Material {
   membrane::SolverSettings solver{};
 };
 
+/// How a skinned body reaches its world (Plugin::add_skinned_body makes one).
+struct WorldLink {
+  btSoftBodyWorldInfo* info = nullptr;
+  /// Adds a piece's body to the world with its broadphase group and mask.
+  std::function<void(btSoftBody*, int group, int mask)> add{};
+  std::function<void(btSoftBody*)> remove{};
+  /// True while the world steps: edits are then refused (empty: never).
+  std::function<bool()> stepping{};
+};
+
 /// What one applied TopologyChange did to the Bullet side.
 struct ApplyStats {
   std::int32_t new_nodes = 0;
@@ -134,11 +145,12 @@ struct ApplyStats {
 class SkinnedSoftBody {
  public:
   /// Builds the pieces of `mesh` (its `current` positions are the initial node positions) and
-  /// adds them to the world through `add`. `skeleton` is copied. Throws std::invalid_argument
-  /// on inconsistent input. Normally made by Plugin::add_skinned_body.
-  SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
-                  std::function<void(btSoftBody*)> remove, const mesh::SkinnedMesh& mesh,
-                  const skin::Skeleton& skeleton, const Material& material);
+  /// adds them to the world through `link.add`, each with `settings`. `skeleton` is copied.
+  /// Throws std::invalid_argument on inconsistent input. Normally made by
+  /// Plugin::add_skinned_body.
+  SkinnedSoftBody(const WorldLink& link, const mesh::SkinnedMesh& mesh,
+                  const skin::Skeleton& skeleton, const Material& material,
+                  const PieceSettings& settings = {});
   ~SkinnedSoftBody();
   SkinnedSoftBody(const SkinnedSoftBody&) = delete;
   SkinnedSoftBody& operator=(const SkinnedSoftBody&) = delete;
@@ -147,6 +159,7 @@ class SkinnedSoftBody {
   /// A fixed pose.
   void set_pose(const skin::Pose& pose);
   /// An animation sampled at the simulated time (wrapped when `loop`). The animation is copied.
+  /// Throws std::invalid_argument when it does not fit the skeleton (Animation::validate).
   void play(const skin::Animation& animation, skin::Blend blend = skin::Blend::linear,
             bool loop = true);
   /// Keyframes set by the user, sampled at the simulated time.
@@ -161,7 +174,9 @@ class SkinnedSoftBody {
   /// above the weight threshold).
   void set_pinned(std::span<const std::int32_t> vertices);
 
-  // --- Topology changes: on the simulated positions, only between stepSimulation calls. ---
+  // --- Topology changes: on the simulated positions, only between stepSimulation calls (an
+  // edit from a step hook or any other code running inside a step throws std::logic_error).
+  // Every query below is valid right after an edit, new vertices included. ---
   mesh::CutResult cut(const cga::Plane<double>& plane, const mesh::CutOptions& options = {});
   mesh::DrillResult drill(const mesh::DrillTool& tool, const mesh::DrillOptions& options = {});
   /// Starts a tear (replacing any earlier one); advance it with tear_advance().
@@ -171,6 +186,26 @@ class SkinnedSoftBody {
   /// Applies a change computed by the caller on mesh() (after sync_mesh()).
   void apply(const mesh::TopologyChange& change);
   const ApplyStats& last_apply() const;
+
+  // --- Pieces: handles, events, inherited settings, release (piece.hpp) ---
+  /// The live pieces' ids (bodies holding nodes), in slot order.
+  std::vector<PieceId> piece_ids() const;
+  /// Whether `id` names a live piece of this body (false for a stale or null id).
+  bool piece_valid(PieceId id) const;
+  /// The live piece's btSoftBody, or null for a stale or null id.
+  btSoftBody* piece_body(PieceId id) const;
+  /// The piece holding `vertex` (null for a detached vertex).
+  PieceId piece_of(std::int32_t vertex) const;
+  /// Adds a listener of piece events (created, removed, body destroyed).
+  void on_piece_event(std::function<void(const PieceEvent&)> listener);
+  /// The piece's settings (throws std::invalid_argument for a stale id; so do the setters).
+  const PieceSettings& piece_settings(PieceId id) const;
+  void set_piece_user(PieceId id, void* user);
+  /// Re-adds the piece's body to the world with this broadphase group and mask.
+  void set_piece_collision(PieceId id, int group, int mask);
+  /// Releases the piece from skinning (ReleaseOptions); pieces split from it stay released.
+  void release_piece(PieceId id, const ReleaseOptions& options = {});
+  bool piece_released(PieceId id) const;
 
   // --- State ---
   /// The mesh with `current` = the simulated node positions as of the last sync_mesh().
