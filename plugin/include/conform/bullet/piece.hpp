@@ -57,6 +57,8 @@ struct PieceSettings {
   /// A template for the pieces' btSoftBody::Config (collision flags, kCHR, kDF, kVC, ...).
   /// Material::damping and Material::position_iterations replace its kDP and piterations.
   /// Unset: Bullet's defaults. A split copies its parent's m_cfg as it is at the time.
+  /// Bullet's Config constructor leaves its fields uninitialized: start a template from a
+  /// body's m_cfg (btSoftBody(&world_info, 0, nullptr, nullptr).m_cfg).
   std::optional<btSoftBody::Config> config{};
 };
 
