@@ -189,10 +189,10 @@ TEST(PluginValidation, ReleaseOptionsAndStaleIdsAreRefusedWithTheirValues) {
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   const bullet::PieceId id = body.piece_ids().at(0);
   bullet::ReleaseOptions bad{};
-  bad.volume_stiffness = -2;
+  bad.volume_modulus = -2;
   EXPECT_NE(message_of([&] {
               body.release_piece(id, bad);
-            }).find("release_piece: volume_stiffness = -2 is out of range (>= 0)"),
+            }).find("release_piece: volume_modulus = -2 is out of range (>= 0 Pa)"),
             std::string::npos);
   EXPECT_FALSE(body.piece_released(id));
   const bullet::PieceId stale{id.index, id.generation + 1};

@@ -25,6 +25,7 @@ SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece(std::int32_t pare
   piece->body = std::make_unique<PieceBody>(info_, this, slot);
   piece->settings = from ? from->settings : defaults_;
   piece->released = from && from->released;
+  if (from) piece->release = from->release;
   btSoftBody& body = *piece->body;
   configure_body(body, from);
   link_.add(&body, piece->settings.collision_group, piece->settings.collision_mask);

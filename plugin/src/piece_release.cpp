@@ -30,14 +30,17 @@ void SkinnedSoftBody::Impl::release_piece(PieceId id, const ReleaseOptions& opti
   require(
       finite(options.link_stiffness) && options.link_stiffness > 0 && options.link_stiffness <= 1,
       "link_stiffness", options.link_stiffness, "(0, 1]");
-  require(finite(options.volume_stiffness) && options.volume_stiffness >= 0, "volume_stiffness",
-          options.volume_stiffness, ">= 0");
-  require(finite(options.pressure) && options.pressure >= 0, "pressure", options.pressure, ">= 0");
-  piece.released = true;
+  require(finite(options.volume_modulus) && options.volume_modulus >= 0, "volume_modulus",
+          options.volume_modulus, ">= 0 Pa");
+  require(finite(options.pressure) && options.pressure >= 0, "pressure", options.pressure,
+          ">= 0 Pa");
   btSoftBody& body = *piece.body;
+  if (options.volume_modulus > 0 || options.pressure > 0)
+    require(body.getVolume() > 0, "the piece's volume (for volume_modulus or pressure)",
+            double(body.getVolume()), "> 0 m^3: a closed, outward-oriented piece");
+  piece.released = true;
+  piece.release = options;
   body.m_materials[0]->m_kLST = btScalar(options.link_stiffness);
-  body.m_cfg.kVC = btScalar(options.volume_stiffness);
-  body.m_cfg.kPR = btScalar(options.pressure);
   release_nodes(piece);
   // The shape at release is the rest shape from now on (what Bullet's own reset would give).
   for (int i = 0; i < body.m_links.size(); ++i) {
@@ -49,7 +52,6 @@ void SkinnedSoftBody::Impl::release_piece(PieceId id, const ReleaseOptions& opti
     link_constant(link);
   }
   piece.reapply = true;
-  body.m_pose.m_bvolume = options.volume_stiffness > 0;
   body.m_pose.m_wgh.clear();  // refresh_released captures the volume now
   refresh_released();
 }
@@ -71,9 +73,15 @@ void SkinnedSoftBody::Impl::refresh_released() {
     btSoftBody& body = *piece->body;
     if (body.m_pose.m_wgh.size() == body.m_nodes.size()) continue;  // nodes unchanged
     release_nodes(*piece);
-    // Bullet's volume force reads only m_bvolume and m_volume (applyForces); m_wgh's size
-    // records the node count the volume was taken at.
-    body.m_pose.m_volume = body.m_pose.m_bvolume ? body.getVolume() : btScalar(0);
+    // Bullet's volume and pressure forces (applyForces) read m_pose.m_volume and kVC, kPR;
+    // m_wgh's size records the node count the volume was taken at (pose matching, which
+    // reads it, is off: m_bframe false).
+    const double volume = double(body.getVolume());
+    const bool closed = volume > 0;
+    body.m_pose.m_bvolume = closed && piece->release.volume_modulus > 0;
+    body.m_pose.m_volume = btScalar(closed ? volume : 0);
+    body.m_cfg.kVC = btScalar(closed ? piece->release.volume_modulus / volume : 0);
+    body.m_cfg.kPR = btScalar(closed ? piece->release.pressure * volume : 0);
     body.m_pose.m_wgh.resize(body.m_nodes.size(), btScalar(0));
   }
 }

@@ -68,10 +68,15 @@ struct PieceSettings {
 struct ReleaseOptions {
   /// kLST of the piece's links, in (0, 1]: their rest lengths become the lengths at release.
   double link_stiffness = 0.9;
-  /// Bullet's volume constraint kVC (>= 0; 0 = off): the piece keeps the volume it has at
-  /// release (Bullet's setPose(volume)). Needs a closed piece (e.g. a capped cut).
-  double volume_stiffness = 0.0;
-  /// Bullet's pressure kPR (>= 0; 0 = off): pushes the faces out along their normals.
+  /// Keeps the volume the piece has at release: a bulk modulus K in Pa (>= 0; 0 = off), the
+  /// pressure K (V0 − V) / V0 pushing the faces out along their normals. Bullet's volume force
+  /// is kVC (V0 − V) per unit of node area, so kVC = K / V0: Bullet's raw kVC is not
+  /// scale-free (a 5 cm piece needs kVC ~ 1e5 to hold against its weight). Needs a closed
+  /// piece (e.g. a capped cut); K well above areal density × g (about 11 Pa for skin) keeps it
+  /// from crushing under its own weight.
+  double volume_modulus = 0.0;
+  /// An inner pressure in Pa at the release volume (>= 0; 0 = off), following Boyle's law
+  /// (Bullet's kPR = p V0, its pressure being kPR / V). Needs a closed piece.
   double pressure = 0.0;
 };
 
