@@ -33,7 +33,10 @@ struct Plugin::Action : btActionInterface {
     for (auto& body : bodies) body->update(static_cast<double>(dt), time);
     for (auto& hook : hooks) hook(static_cast<double>(dt));
   }
-  void debugDraw(btIDebugDraw*) override {}
+  void debugDraw(btIDebugDraw* drawer) override {
+    if (!drawer) return;
+    for (auto& body : bodies) body->debug_draw(*drawer);
+  }
 };
 
 // The world's witness: an object in the world that collides with nothing. Bullet's world

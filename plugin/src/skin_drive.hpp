@@ -45,6 +45,8 @@ class SkinDrive {
   void extend(const mesh::SkinnedMesh& mesh);
 
   const skin::SoaPoints<double>& targets() const { return target_; }
+  /// The pose of the last skinning (the rest pose before the first).
+  const skin::Pose& pose() const { return pose_; }
   const skin::SoaPoints<double>& previous_targets() const { return previous_; }
   Eigen::Vector3d target(std::int32_t v) const {
     const auto i = static_cast<std::size_t>(v);

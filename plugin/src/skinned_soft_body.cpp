@@ -471,6 +471,22 @@ bool SkinnedSoftBody::piece_released(PieceId id) const {
   return impl_->piece_released(id);
 }
 
+std::uint64_t SkinnedSoftBody::topology_version() const {
+  return impl_->topology_version_;
+}
+Eigen::Matrix3Xd SkinnedSoftBody::normals() const {
+  return impl_->normals();
+}
+const skin::Pose& SkinnedSoftBody::pose() const {
+  return impl_->drive_.pose();
+}
+std::vector<skin::Versor> SkinnedSoftBody::joint_transforms() const {
+  return impl_->joint_transforms();
+}
+void SkinnedSoftBody::debug_draw(btIDebugDraw& drawer) const {
+  impl_->debug_draw(drawer);
+}
+
 void SkinnedSoftBody::update(double dt, double time) {
   impl_->update(dt, time);
 }

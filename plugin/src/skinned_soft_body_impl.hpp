@@ -118,6 +118,10 @@ struct SkinnedSoftBody::Impl {
   void deliver_events();
   /// Called by a PieceBody the application deletes.
   void body_deleted_by_app(std::int32_t slot);
+  // --- Render data (render_data.cpp) ---
+  Eigen::Matrix3Xd normals() const;
+  std::vector<skin::Versor> joint_transforms() const;
+  void debug_draw(btIDebugDraw& drawer) const;
   // --- Release (piece_release.cpp) ---
   void release_piece(PieceId id, const ReleaseOptions& options);
   void release_nodes(Piece& piece);
@@ -256,9 +260,10 @@ struct SkinnedSoftBody::Impl {
   std::vector<std::unique_ptr<Piece>> pieces_;  // null once emptied
   std::vector<std::uint32_t> generation_;       // per slot; changes when its piece is removed
   std::vector<std::function<void(const PieceEvent&)>> listeners_;
-  std::vector<PieceEvent> events_;  // queued during an edit, delivered after it
-  std::string lost_;                // why the body is unusable (a piece deleted by the app)
-  double time_ = 0;                 // of the last substep (targets after an edit)
+  std::vector<PieceEvent> events_;      // queued during an edit, delivered after it
+  std::string lost_;                    // why the body is unusable (a piece deleted by the app)
+  double time_ = 0;                     // of the last substep (targets after an edit)
+  std::uint64_t topology_version_ = 0;  // changes mirrored
   ApplyStats stats_;
 };
 

@@ -25,6 +25,7 @@ void erase_value(std::vector<std::int32_t>& list, std::int32_t value) {
 }  // namespace
 
 void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
+  ++topology_version_;
   membrane_.invalidate();  // rebuilt from the rest mesh at the next substep
   const double start = thread_seconds();
   const std::int32_t v0 = change.base_vertex_count;

@@ -51,6 +51,7 @@
 #include "conform/skin/skeleton.hpp"
 
 class btSoftBody;
+class btIDebugDraw;
 struct btSoftBodyWorldInfo;
 
 namespace conform::bullet {
@@ -250,6 +251,22 @@ class SkinnedSoftBody {
   /// and node_of() −1.
   bool detached(std::int32_t vertex) const;
   std::int32_t detached_count() const;
+
+  // --- Render data and pose (render_data.cpp) ---
+  /// Changes mirrored since construction: +1 per TopologyChange (a drill or tear step may
+  /// apply several). Face and vertex indices of mesh() may be reshuffled whenever it changes.
+  std::uint64_t topology_version() const;
+  /// Per vertex, the unit area-weighted normal of its faces at the simulated positions (zero
+  /// for a vertex without faces); #V by 3 columns as mesh().current.
+  Eigen::Matrix3Xd normals() const;
+  /// The skeleton pose of the last substep (local versors; the rest pose before the first).
+  const skin::Pose& pose() const;
+  /// The global versor of every joint for pose() (joint space → mesh space).
+  std::vector<skin::Versor> joint_transforms() const;
+  /// Draws the skeleton (joint to parent, yellow) and, for every driven node in Bullet, the
+  /// offset to its skinned target (cyan). Called by the plugin's action from
+  /// btDynamicsWorld::debugDrawWorld; Bullet draws the pieces themselves.
+  void debug_draw(btIDebugDraw& drawer) const;
 
   /// The membrane's solve of the last substep (residual in Pa, iterations); zero with
   /// bullet_links.

@@ -1,0 +1,93 @@
+// Render data on a live body: a change counter that moves with every mirrored change, current
+// normals (outward on the arm), the pose and joint transforms of the last substep (checked
+// against the geometry of a bent shoulder), and the debug drawing through Bullet's own
+// debugDrawWorld, counted by a test btIDebugDraw.
+#include <LinearMath/btIDebugDraw.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "conform/bullet/plugin.hpp"
+#include "conform/skin/procedural_arm.hpp"
+#include "plugin_world.hpp"
+
+using namespace conform;
+using conform::test::SoftWorld;
+
+namespace {
+
+struct CountingDraw : btIDebugDraw {
+  int mode = DBG_DrawWireframe;
+  int skeleton = 0, offsets = 0, other = 0;
+  void drawLine(const btVector3&, const btVector3&, const btVector3& color) override {
+    if (color == btVector3(1, 1, 0))
+      ++skeleton;
+    else if (color == btVector3(0, 1, 1))
+      ++offsets;
+    else
+      ++other;
+  }
+  void drawContactPoint(const btVector3&, const btVector3&, btScalar, int,
+                        const btVector3&) override {}
+  void reportErrorWarning(const char*) override {}
+  void draw3dText(const btVector3&, const char*) override {}
+  void setDebugMode(int m) override { mode = m; }
+  int getDebugMode() const override { return mode; }
+};
+
+}  // namespace
+
+TEST(PluginRender, CounterNormalsPoseAndDebugDraw) {
+  SoftWorld world;
+  bullet::Plugin plugin(world.world);
+  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
+  EXPECT_EQ(body.topology_version(), 0u);
+
+  // Normals at rest: outward, i.e. along the radius, on the upper arm's middle.
+  const Eigen::Matrix3Xd n = body.normals();
+  int checked = 0;
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v) {
+    const Eigen::Vector3d x = body.position(v);
+    if (x.z() < 0.1 || x.z() > 0.2) continue;
+    const Eigen::Vector3d radial = Eigen::Vector3d(x.x(), x.y(), 0).normalized();
+    EXPECT_NEAR(n.col(v).norm(), 1.0, 1e-12);
+    EXPECT_GT(n.col(v).dot(radial), 0.95) << "vertex " << v;
+    ++checked;
+  }
+  EXPECT_GT(checked, 24);
+
+  // The pose of the last substep: the shoulder turned 0.3 rad about y puts the elbow joint
+  // (0.30 m along z at rest) at (0.30 sin 0.3, 0, 0.30 cos 0.3).
+  body.set_pose(test::bent_arm_pose(arm.skeleton, 0.3, 0.0));
+  world.step(1);
+  const auto global = body.joint_transforms();
+  ASSERT_EQ(global.size(), 3u);
+  const auto elbow = global[1].apply(cga::Vec3<double>::Zero());
+  EXPECT_NEAR(elbow.x(), 0.30 * std::sin(0.3), 1e-9);
+  EXPECT_NEAR(elbow.y(), 0.0, 1e-9);
+  EXPECT_NEAR(elbow.z(), 0.30 * std::cos(0.3), 1e-9);
+  EXPECT_EQ(body.pose().local.size(), arm.skeleton.joints.size());
+
+  // A cut moves the counter; the debug drawing then has one skeleton line per joint with a
+  // parent and one target offset per driven node, in every piece.
+  body.cut(cga::Plane<double>::from_normal_point({0, 0, 1}, {0, 0, 0.42}));
+  EXPECT_GE(body.topology_version(), 1u);
+  world.step(1);
+  CountingDraw draw;
+  world.world.setDebugDrawer(&draw);
+  world.world.debugDrawWorld();
+  world.world.setDebugDrawer(nullptr);
+  int nodes = 0;
+  for (btSoftBody* sb : body.pieces()) nodes += sb->m_nodes.size();
+  EXPECT_EQ(draw.skeleton, 2);  // elbow → shoulder, wrist → elbow
+  EXPECT_EQ(draw.offsets, nodes);
+  EXPECT_GT(draw.other, 0);  // Bullet's own wireframe of the pieces
+  // A released piece is Bullet's alone: no target offsets for it.
+  const bullet::PieceId last = body.piece_ids().back();
+  const int released_nodes = body.piece_body(last)->m_nodes.size();
+  body.release_piece(last);
+  CountingDraw after;
+  body.debug_draw(after);
+  EXPECT_EQ(after.offsets, nodes - released_nodes);
+}
