@@ -5,7 +5,10 @@
 #include <LinearMath/btIDebugDraw.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <stdexcept>
 
 #include "conform/bullet/plugin.hpp"
 #include "conform/skin/procedural_arm.hpp"
@@ -90,4 +93,45 @@ TEST(PluginRender, CounterNormalsPoseAndDebugDraw) {
   CountingDraw after;
   body.debug_draw(after);
   EXPECT_EQ(after.offsets, nodes - released_nodes);
+}
+
+TEST(PluginRender, ClockAndSnapToTheFirstPose) {
+  SoftWorld world;
+  bullet::Plugin plugin(world.world);
+  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  const skin::Pose bent = test::bent_arm_pose(arm.skeleton, 0.0, 1.2);
+  auto max_speed = [](const bullet::SkinnedSoftBody& body) {
+    double s = 0;
+    for (std::int32_t v = 0; v < body.vertex_count(); ++v) s = std::max(s, body.velocity(v).norm());
+    return s;
+  };
+  // Without a snap the first substep jumps from the bind pose to the bent elbow.
+  auto& jumping = plugin.add_skinned_body(arm.mesh, arm.skeleton);
+  jumping.set_pose(bent);
+  auto& snapped = plugin.add_skinned_body(arm.mesh, arm.skeleton);
+  snapped.set_pose(bent);
+  snapped.snap_to_pose();
+  double worst = 0;
+  for (std::int32_t v = 0; v < snapped.vertex_count(); ++v)
+    worst = std::max(worst, (snapped.position(v) - snapped.target(v)).norm());
+  EXPECT_LT(worst, 1e-6);
+  world.step(1);
+  std::printf("first substep, max node speed: %.2f m/s without snap, %.4f m/s with\n",
+              max_speed(jumping), max_speed(snapped));
+  // What is left after a snap is the membrane settling on the bent pose's targets (measured
+  // 0.55 m/s at the elbow's crease, against 22 m/s for the jump from the bind pose).
+  EXPECT_GT(max_speed(jumping), 5.0);
+  EXPECT_LT(max_speed(snapped), 0.1 * max_speed(jumping));
+
+  // The body's own clock: start 2 s, half speed, then paused.
+  snapped.set_clock({2.0, 0.5, false});
+  world.step(6);
+  const double eps = sizeof(btScalar) == 4 ? 1e-6 : 1e-12;  // Bullet hands dt as btScalar
+  EXPECT_NEAR(snapped.clock_time(), 2.0 + 0.5 * 6 / 60.0, eps);
+  EXPECT_NEAR(jumping.clock_time(), plugin.time(), 1e-12);  // no clock: the plugin's
+  snapped.set_clock({snapped.clock_time(), 0.5, true});
+  const double frozen = snapped.clock_time();
+  world.step(3);
+  EXPECT_EQ(snapped.clock_time(), frozen);
+  EXPECT_THROW(snapped.set_clock({0.0, std::nan(""), false}), std::invalid_argument);
 }

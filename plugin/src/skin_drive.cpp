@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "bullet_surgery.hpp"
 #include "piece_books.hpp"
 
 namespace conform::bullet {
@@ -104,7 +105,12 @@ void SkinnedSoftBody::Impl::update(double dt, double time) {
   if (!lost_.empty()) throw std::logic_error("SkinnedSoftBody: cannot step: " + lost_);
   if (!(dt > 0)) return;
   time_ = time;
-  drive_.advance(mesh_, time);
+  if (clock_) {
+    if (!clock_->paused) clock_now_ += clock_->speed * dt;
+  } else {
+    clock_now_ = time;
+  }
+  drive_.advance(mesh_, clock_now_);
   for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot) {
     // A detached vertex rides its target.
     const auto v = static_cast<std::size_t>(detached_vertex_[slot]);
@@ -191,6 +197,35 @@ void SkinnedSoftBody::Impl::reapply_rest_lengths(Piece& piece) {
     body.m_links[i].m_rl = btScalar(r);
     body.m_links[i].m_c1 = btScalar(r * r);
   }
+}
+
+void SkinnedSoftBody::Impl::set_clock(const Clock& clock) {
+  if (!std::isfinite(clock.start) || !std::isfinite(clock.speed))
+    throw std::invalid_argument(
+        "SkinnedSoftBody::set_clock: start = " + std::to_string(clock.start) +
+        " s, speed = " + std::to_string(clock.speed) + ": both must be finite");
+  clock_ = clock;
+  clock_now_ = clock.start;
+}
+
+void SkinnedSoftBody::Impl::snap_to_pose() {
+  check_editable("snap_to_pose");
+  drive_.settle(mesh_, clock_now_);
+  for (auto& piece : pieces_) {
+    if (!piece || !piece->body || piece->released) continue;
+    btSoftBody& body = *piece->body;
+    for (int i = 0; i < body.m_nodes.size(); ++i) {
+      btSoftBody::Node& node = body.m_nodes[i];
+      node.m_x = node.m_q = to_bt(drive_.target(piece->node_vertex[static_cast<std::size_t>(i)]));
+      node.m_v = btVector3(0, 0, 0);
+      if (node.m_leaf)
+        node.m_leaf->volume = btDbvtVolume::FromCR(node.m_x, body.getCollisionShape()->getMargin());
+    }
+    refit_tree(body.m_ndbvt.m_root);  // the leaves moved: their ancestors follow
+  }
+  for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot)
+    detached_state_[slot] = {drive_.target(detached_vertex_[slot]), Eigen::Vector3d::Zero()};
+  membrane_.invalidate();  // its carried solution is of the old positions
 }
 
 void SkinnedSoftBody::Impl::skin_targets(double time) {

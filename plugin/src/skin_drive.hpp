@@ -43,6 +43,11 @@ class SkinDrive {
   /// After an edit added vertices: their targets now (the last pose, the source not asked
   /// again), their previous targets equal to them, so that target(v) is valid at once.
   void extend(const mesh::SkinnedMesh& mesh);
+  /// The targets at `time` become the previous ones too (zero target velocity).
+  void settle(const mesh::SkinnedMesh& mesh, double time) {
+    skin(mesh, time);
+    previous_ = target_;
+  }
 
   const skin::SoaPoints<double>& targets() const { return target_; }
   /// The pose of the last skinning (the rest pose before the first).

@@ -326,6 +326,15 @@ void SkinnedSoftBody::set_keyframes(skin::PoseTrack track, skin::Blend blend) {
 void SkinnedSoftBody::set_pose_source(std::function<void(double, skin::Pose&)> source) {
   impl_->set_pose_source(std::move(source));
 }
+void SkinnedSoftBody::set_clock(const Clock& clock) {
+  impl_->set_clock(clock);
+}
+double SkinnedSoftBody::clock_time() const {
+  return impl_->clock_now_;
+}
+void SkinnedSoftBody::snap_to_pose() {
+  impl_->snap_to_pose();
+}
 void SkinnedSoftBody::set_skin_threads(int threads) {
   impl_->set_skin_threads(threads);
 }

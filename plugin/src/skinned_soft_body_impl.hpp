@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <tuple>
@@ -53,6 +54,8 @@ struct SkinnedSoftBody::Impl {
     drive_.set_pose_source(std::move(source));
   }
   void set_skin_threads(int threads) { drive_.set_threads(threads); }
+  void set_clock(const Clock& clock);
+  void snap_to_pose();
   void set_pinned(std::span<const std::int32_t> vertices);
 
   // --- Topology changes: on the simulated positions, only between stepSimulation calls. ---
@@ -264,6 +267,8 @@ struct SkinnedSoftBody::Impl {
   std::string lost_;                    // why the body is unusable (a piece deleted by the app)
   double time_ = 0;                     // of the last substep (targets after an edit)
   std::uint64_t topology_version_ = 0;  // changes mirrored
+  std::optional<Clock> clock_;          // the body's own animation clock, when set
+  double clock_now_ = 0;                // the time the pose source was last sampled at
   ApplyStats stats_;
 };
 

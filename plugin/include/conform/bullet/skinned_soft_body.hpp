@@ -167,6 +167,21 @@ class SkinnedSoftBody {
   void set_keyframes(skin::PoseTrack track, skin::Blend blend = skin::Blend::linear);
   /// Any other source, e.g. an arm rig: writes the pose for `time` into `pose`.
   void set_pose_source(std::function<void(double time, skin::Pose& pose)> source);
+  /// The body's own animation clock (opt-in): from this call on, the pose source is sampled at
+  /// start + speed × (simulated time since the call), frozen while paused (call again to
+  /// change speed or to pause; `start` then restarts it). Without it: the plugin's time.
+  struct Clock {
+    double start = 0;  // s
+    double speed = 1;  // finite; negative runs backwards
+    bool paused = false;
+  };
+  void set_clock(const Clock& clock);
+  /// The time the pose source was last sampled at, s.
+  double clock_time() const;
+  /// Places every node in Bullet on its skinned target at the current time, at rest (position
+  /// = target, velocity 0). Call after choosing the pose source and before stepping, so that
+  /// the first substep does not jump from the bind pose to the source's first pose.
+  void snap_to_pose();
   /// OpenMP threads of the skinning loop; 0 = the library's choice. Default 1: a fork/join
   /// every substep costs more than it saves on a few thousand vertices, and idle OpenMP
   /// workers spinning on the second core slowed each Bullet step by 3-7× in our measurements.
