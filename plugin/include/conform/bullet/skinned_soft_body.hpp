@@ -191,7 +191,8 @@ class SkinnedSoftBody {
   void set_pinned(std::span<const std::int32_t> vertices);
 
   // --- Topology changes: on the simulated positions, only between stepSimulation calls (an
-  // edit from a step hook or any other code running inside a step throws std::logic_error).
+  // edit from the plugin's action, i.e. a step hook or a pose source, throws
+  // std::logic_error; one from the application's own internal tick callback is not detected).
   // Every query below is valid right after an edit, new vertices included. ---
   mesh::CutResult cut(const cga::Plane<double>& plane, const mesh::CutOptions& options = {});
   mesh::DrillResult drill(const mesh::DrillTool& tool, const mesh::DrillOptions& options = {});
