@@ -12,6 +12,7 @@
 
 #include "conform/bullet/plugin.hpp"
 #include "conform/skin/procedural_arm.hpp"
+#include "conform/skin/skinner.hpp"
 #include "plugin_world.hpp"
 
 using namespace conform;
@@ -134,4 +135,40 @@ TEST(PluginRender, ClockAndSnapToTheFirstPose) {
   world.step(3);
   EXPECT_EQ(snapped.clock_time(), frozen);
   EXPECT_THROW(snapped.set_clock({0.0, std::nan(""), false}), std::invalid_argument);
+}
+
+TEST(PluginRender, AWorldTransformPlacesTheSkinnedTargets) {
+  SoftWorld world;
+  bullet::Plugin plugin(world.world);
+  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
+  const skin::Pose pose = test::bent_arm_pose(arm.skeleton, 0.2, 0.9);
+  body.set_pose(pose);
+  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+  t.rotate(Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()));
+  t.pretranslate(Eigen::Vector3d(1.0, -2.0, 0.5));
+  body.set_world_transform(t);
+  body.snap_to_pose();
+  // Independently: core's skinning in model space, then the transform.
+  skin::Skinner<double> skinner(arm.skeleton, arm.mesh.rest,
+                                skin::Influences<double>::from_mesh(arm.mesh));
+  skinner.skin(pose, skin::SkinMode::cga);
+  const auto& m = skinner.output();
+  const double eps = sizeof(btScalar) == 4 ? 1e-5 : 1e-12;
+  double worst = 0;
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v) {
+    const auto i = static_cast<std::size_t>(v);
+    const Eigen::Vector3d expected = t * Eigen::Vector3d(m.x[i], m.y[i], m.z[i]);
+    worst =
+        std::max({worst, (body.target(v) - expected).norm(), (body.position(v) - expected).norm()});
+  }
+  EXPECT_LT(worst, eps);
+  world.step(2);  // the targets stay placed
+  for (std::int32_t v = 0; v < body.vertex_count(); v += 17) {
+    const auto i = static_cast<std::size_t>(v);
+    EXPECT_LT((body.target(v) - t * Eigen::Vector3d(m.x[i], m.y[i], m.z[i])).norm(), 1e-12);
+  }
+  Eigen::Isometry3d scaled = Eigen::Isometry3d::Identity();
+  scaled.linear() *= 2;
+  EXPECT_THROW(body.set_world_transform(scaled), std::invalid_argument);
 }

@@ -77,6 +77,16 @@ void SkinDrive::skin(const mesh::SkinnedMesh& mesh, double time) {
                                 " joints at t = " + std::to_string(time) + " s, the skeleton has " +
                                 std::to_string(skeleton_->joints.size()));
   skinner_->skin(pose_, skin::SkinMode::cga, target_);
+  place();
+}
+
+void SkinDrive::place() {
+  if (transform_.matrix() == Eigen::Matrix4d::Identity()) return;
+  for (std::size_t v = 0; v < target_.size(); ++v) {
+    const Eigen::Vector3d t =
+        transform_ * Eigen::Vector3d(target_.x[v], target_.y[v], target_.z[v]);
+    target_.x[v] = t.x(), target_.y[v] = t.y(), target_.z[v] = t.z();
+  }
 }
 
 void SkinDrive::extend(const mesh::SkinnedMesh& mesh) {
@@ -84,6 +94,7 @@ void SkinDrive::extend(const mesh::SkinnedMesh& mesh) {
   const std::size_t old = target_.size();
   rebuild_inputs(mesh);
   skinner_->skin(pose_, skin::SkinMode::cga, target_);
+  place();
   for (std::size_t v = old; v < target_.size(); ++v)
     previous_.x[v] = target_.x[v], previous_.y[v] = target_.y[v], previous_.z[v] = target_.z[v];
   fill_previous_ = false;

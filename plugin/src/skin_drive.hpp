@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -50,6 +51,9 @@ class SkinDrive {
   }
 
   const skin::SoaPoints<double>& targets() const { return target_; }
+  /// Where the skinned (model-space) targets are placed in the world.
+  void set_transform(const Eigen::Isometry3d& transform) { transform_ = transform; }
+  const Eigen::Isometry3d& transform() const { return transform_; }
   /// The pose of the last skinning (the rest pose before the first).
   const skin::Pose& pose() const { return pose_; }
   const skin::SoaPoints<double>& previous_targets() const { return previous_; }
@@ -72,6 +76,8 @@ class SkinDrive {
   // substep's start swaps the two buffers.
   skin::SoaPoints<double> target_, previous_;
   bool fill_previous_ = false;  // vertices were added: their previous targets are NaN
+  Eigen::Isometry3d transform_ = Eigen::Isometry3d::Identity();
+  void place();  // transform_ applied to the targets just skinned
   int threads_ = 1;
 };
 

@@ -326,6 +326,19 @@ void SkinnedSoftBody::set_keyframes(skin::PoseTrack track, skin::Blend blend) {
 void SkinnedSoftBody::set_pose_source(std::function<void(double, skin::Pose&)> source) {
   impl_->set_pose_source(std::move(source));
 }
+void SkinnedSoftBody::set_world_transform(const Eigen::Isometry3d& transform) {
+  if (!transform.matrix().allFinite())
+    throw std::invalid_argument("SkinnedSoftBody::set_world_transform: non-finite transform");
+  const Eigen::Matrix3d r = transform.linear();
+  if (!(r.transpose() * r).isIdentity(1e-9) || r.determinant() < 0)
+    throw std::invalid_argument(
+        "SkinnedSoftBody::set_world_transform: the linear part is not a rotation (a rigid "
+        "transform is needed: scale the mesh instead)");
+  impl_->drive_.set_transform(transform);
+}
+const Eigen::Isometry3d& SkinnedSoftBody::world_transform() const {
+  return impl_->drive_.transform();
+}
 void SkinnedSoftBody::set_clock(const Clock& clock) {
   impl_->set_clock(clock);
 }

@@ -31,6 +31,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -167,6 +168,13 @@ class SkinnedSoftBody {
   void set_keyframes(skin::PoseTrack track, skin::Blend blend = skin::Blend::linear);
   /// Any other source, e.g. an arm rig: writes the pose for `time` into `pose`.
   void set_pose_source(std::function<void(double time, skin::Pose& pose)> source);
+  /// Where the body is in the world: the skinned targets (model space, as the mesh and the
+  /// skeleton) are placed by this rigid transform (default identity) from the next substep
+  /// on; the nodes follow through the drive, or at once with snap_to_pose(). Positions,
+  /// targets, cut planes, tear samples and drill tools are in world space; mesh().rest stays
+  /// in model space.
+  void set_world_transform(const Eigen::Isometry3d& transform);
+  const Eigen::Isometry3d& world_transform() const;
   /// The body's own animation clock (opt-in): from this call on, the pose source is sampled at
   /// start + speed × (simulated time since the call), frozen while paused (call again to
   /// change speed or to pause; `start` then restarts it). Without it: the plugin's time.
