@@ -86,9 +86,12 @@ void BM_StepUnskinned(benchmark::State& state) {
   const double pretension = double(state.range(0)) / 100;
   SoftWorld w;
   const auto& arm = the_arm();
+  bullet::WorldLink link;
+  link.info = &w.world.getWorldInfo();
+  link.add = [&](btSoftBody* b, int group, int mask) { w.world.addSoftBody(b, group, mask); };
+  link.remove = [&](btSoftBody* b) { w.world.removeSoftBody(b); };
   bullet::SkinnedSoftBody body(
-      w.world.getWorldInfo(), [&](btSoftBody* b) { w.world.addSoftBody(b); },
-      [&](btSoftBody* b) { w.world.removeSoftBody(b); }, arm.mesh, arm.skeleton,
+      link, arm.mesh, arm.skeleton,
       {.model = bullet::MaterialModel::bullet_links, .pretension = pretension});
   w.step(10);
   for (auto _ : state) w.step();

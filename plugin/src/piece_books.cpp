@@ -10,26 +10,59 @@
 
 namespace conform::bullet {
 
-SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece() {
+SkinnedSoftBody::Impl::PieceBody::~PieceBody() {
+  if (owner) owner->body_deleted_by_app(slot);
+}
+
+SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece(std::int32_t parent) {
+  const auto slot = std::int32_t(pieces_.size());
+  const Piece* from = parent >= 0 && pieces_[static_cast<std::size_t>(parent)] &&
+                              pieces_[static_cast<std::size_t>(parent)]->body
+                          ? pieces_[static_cast<std::size_t>(parent)].get()
+                          : nullptr;
   auto piece = std::make_unique<Piece>();
   // This constructor (unlike the world-info-only one) creates the default material.
-  piece->body = std::make_unique<btSoftBody>(info_, 0, nullptr, nullptr);
+  piece->body = std::make_unique<PieceBody>(info_, this, slot);
+  piece->settings = from ? from->settings : defaults_;
+  piece->released = from && from->released;
+  if (from) piece->release = from->release;
   btSoftBody& body = *piece->body;
-  // The membrane's links only carry the topology (inert, c0 = 0).
-  body.m_materials[0]->m_kLST = membrane_model() ? btScalar(0) : btScalar(material_.link_stiffness);
-  if (material_.bending_stiffness > 0)
-    body.appendMaterial()->m_kLST = btScalar(material_.bending_stiffness);  // material 1
-  body.m_cfg.kDP = btScalar(material_.damping);
-  body.m_cfg.piterations = material_.position_iterations;
-  body.getCollisionShape()->setMargin(btScalar(material_.margin));
+  configure_body(body, from);
+  link_.add(&body, piece->settings.collision_group, piece->settings.collision_mask);
+  pieces_.push_back(std::move(piece));
+  generation_.push_back(1);
+  events_.push_back(
+      {PieceEvent::Kind::created, id_of_slot(slot), from ? id_of_slot(parent) : PieceId{}});
+  ++stats_.new_pieces;
+  return *pieces_.back();
+}
+
+void SkinnedSoftBody::Impl::configure_body(btSoftBody& body, const Piece* from) {
+  // A split copies its parent's body settings as they are (the application may have changed
+  // them); pieces made at construction take the template and the material.
+  if (from) {
+    const btSoftBody& old = *from->body;
+    body.m_cfg = old.m_cfg;
+    body.m_materials[0]->m_kLST = old.m_materials[0]->m_kLST;
+    if (old.m_materials.size() > 1) body.appendMaterial()->m_kLST = old.m_materials[1]->m_kLST;
+    body.m_pose.m_bvolume = old.m_pose.m_bvolume;
+    body.getCollisionShape()->setMargin(old.getCollisionShape()->getMargin());
+  } else {
+    if (defaults_.config) body.m_cfg = *defaults_.config;
+    // The membrane's links only carry the topology (inert, c0 = 0).
+    body.m_materials[0]->m_kLST =
+        membrane_model() ? btScalar(0) : btScalar(material_.link_stiffness);
+    if (material_.bending_stiffness > 0)
+      body.appendMaterial()->m_kLST = btScalar(material_.bending_stiffness);  // material 1
+    body.m_cfg.kDP = btScalar(material_.damping);
+    body.m_cfg.piterations = material_.position_iterations;
+    body.getCollisionShape()->setMargin(btScalar(material_.margin));
+  }
+  body.setUserPointer(from ? from->settings.user : defaults_.user);
   body.setActivationState(DISABLE_DEACTIVATION);
   // A new btSoftBody asks for Bullet's whole-body reset at its first step; the plugin writes
   // every constant of what it adds (rest lengths, link constants, areas), so none is needed.
   body.m_bUpdateRtCst = false;
-  add_(&body);
-  pieces_.push_back(std::move(piece));
-  ++stats_.new_pieces;
-  return *pieces_.back();
 }
 
 void SkinnedSoftBody::Impl::build(const mesh::SkinnedMesh& m) {
@@ -150,11 +183,14 @@ void SkinnedSoftBody::Impl::place_faces_and_links(const mesh::SkinnedMesh& m) {
 
 void SkinnedSoftBody::Impl::drop_empty_pieces() {
   // Pieces left without nodes leave the world.
-  for (auto& piece : pieces_)
-    if (piece && piece->body->m_nodes.size() == 0) {
-      remove_(piece->body.get());
-      piece.reset();
-    }
+  for (std::size_t slot = 0; slot < pieces_.size(); ++slot) {
+    auto& piece = pieces_[slot];
+    if (!piece || !piece->body || piece->body->m_nodes.size() != 0) continue;
+    events_.push_back({PieceEvent::Kind::removed, id_of_slot(std::int32_t(slot)), {}});
+    link_.remove(piece->body.get());
+    piece.reset();
+    ++generation_[slot];  // every id of it is stale from now on
+  }
 }
 
 void SkinnedSoftBody::Impl::detach(std::int32_t v) {
@@ -301,7 +337,7 @@ void SkinnedSoftBody::Impl::mark_moving_links(PieceMove& move) {
 
 void SkinnedSoftBody::Impl::open_new_body(PieceMove& move, std::int32_t joining,
                                           std::int32_t added_faces) {
-  Piece& into = new_piece();
+  Piece& into = new_piece(move.sources.empty() ? -1 : move.sources[0]);
   move.into = std::int32_t(pieces_.size()) - 1;
   btSoftBody& body = *into.body;
   // An empty body: reserving moves nothing that is pointed to. Room for what this change still

@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "bullet_surgery.hpp"
 #include "piece_books.hpp"
 
 namespace conform::bullet {
@@ -70,7 +71,33 @@ void SkinDrive::rebuild_inputs(const mesh::SkinnedMesh& mesh) {
 void SkinDrive::skin(const mesh::SkinnedMesh& mesh, double time) {
   if (target_.size() != static_cast<std::size_t>(mesh.vertex_count())) rebuild_inputs(mesh);
   if (source_) source_(time, pose_);
+  if (pose_.local.size() != skeleton_->joints.size())  // a source's pose of another skeleton
+    throw std::invalid_argument("SkinnedSoftBody: the pose source gave " +
+                                std::to_string(pose_.local.size()) +
+                                " joints at t = " + std::to_string(time) + " s, the skeleton has " +
+                                std::to_string(skeleton_->joints.size()));
   skinner_->skin(pose_, skin::SkinMode::cga, target_);
+  place();
+}
+
+void SkinDrive::place() {
+  if (transform_.matrix() == Eigen::Matrix4d::Identity()) return;
+  for (std::size_t v = 0; v < target_.size(); ++v) {
+    const Eigen::Vector3d t =
+        transform_ * Eigen::Vector3d(target_.x[v], target_.y[v], target_.z[v]);
+    target_.x[v] = t.x(), target_.y[v] = t.y(), target_.z[v] = t.z();
+  }
+}
+
+void SkinDrive::extend(const mesh::SkinnedMesh& mesh) {
+  if (target_.size() == static_cast<std::size_t>(mesh.vertex_count())) return;
+  const std::size_t old = target_.size();
+  rebuild_inputs(mesh);
+  skinner_->skin(pose_, skin::SkinMode::cga, target_);
+  place();
+  for (std::size_t v = old; v < target_.size(); ++v)
+    previous_.x[v] = target_.x[v], previous_.y[v] = target_.y[v], previous_.z[v] = target_.z[v];
+  fill_previous_ = false;
 }
 
 void SkinDrive::advance(const mesh::SkinnedMesh& mesh, double time) {
@@ -86,8 +113,15 @@ void SkinDrive::advance(const mesh::SkinnedMesh& mesh, double time) {
 // --- The per-substep drive ---
 
 void SkinnedSoftBody::Impl::update(double dt, double time) {
+  if (!lost_.empty()) throw std::logic_error("SkinnedSoftBody: cannot step: " + lost_);
   if (!(dt > 0)) return;
-  drive_.advance(mesh_, time);
+  time_ = time;
+  if (clock_) {
+    if (!clock_->paused) clock_now_ += clock_->speed * dt;
+  } else {
+    clock_now_ = time;
+  }
+  drive_.advance(mesh_, clock_now_);
   for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot) {
     // A detached vertex rides its target.
     const auto v = static_cast<std::size_t>(detached_vertex_[slot]);
@@ -100,7 +134,7 @@ void SkinnedSoftBody::Impl::update(double dt, double time) {
   }
   for (auto& piece : pieces_) {
     if (!piece) continue;
-    drive_nodes(*piece, dt);
+    if (!piece->released) drive_nodes(*piece, dt);  // a released piece is Bullet's alone
     reapply_rest_lengths(*piece);
   }
 }
@@ -119,7 +153,7 @@ void SkinnedSoftBody::Impl::step_membrane(double dt) {
     previous_matrix_.col(Eigen::Index(v)) << previous.x[v], previous.y[v], previous.z[v];
   }
   for (auto& piece : pieces_) {
-    if (!piece) continue;
+    if (!piece || piece->released) continue;  // released: the membrane leaves it alone
     btSoftBody& body = *piece->body;
     for (int i = 0; i < body.m_nodes.size(); ++i) {
       btSoftBody::Node& node = body.m_nodes[i];
@@ -176,15 +210,51 @@ void SkinnedSoftBody::Impl::reapply_rest_lengths(Piece& piece) {
   }
 }
 
+void SkinnedSoftBody::Impl::set_clock(const Clock& clock) {
+  if (!std::isfinite(clock.start) || !std::isfinite(clock.speed))
+    throw std::invalid_argument(
+        "SkinnedSoftBody::set_clock: start = " + std::to_string(clock.start) +
+        " s, speed = " + std::to_string(clock.speed) + ": both must be finite");
+  clock_ = clock;
+  clock_now_ = clock.start;
+}
+
+void SkinnedSoftBody::Impl::snap_to_pose() {
+  check_editable("snap_to_pose");
+  drive_.settle(mesh_, clock_now_);
+  for (auto& piece : pieces_) {
+    if (!piece || !piece->body || piece->released) continue;
+    btSoftBody& body = *piece->body;
+    for (int i = 0; i < body.m_nodes.size(); ++i) {
+      btSoftBody::Node& node = body.m_nodes[i];
+      node.m_x = node.m_q = to_bt(drive_.target(piece->node_vertex[static_cast<std::size_t>(i)]));
+      node.m_v = btVector3(0, 0, 0);
+      if (node.m_leaf)
+        node.m_leaf->volume = btDbvtVolume::FromCR(node.m_x, body.getCollisionShape()->getMargin());
+    }
+    refit_tree(body.m_ndbvt.m_root);  // the leaves moved: their ancestors follow
+  }
+  for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot)
+    detached_state_[slot] = {drive_.target(detached_vertex_[slot]), Eigen::Vector3d::Zero()};
+  membrane_.invalidate();  // its carried solution is of the old positions
+}
+
 void SkinnedSoftBody::Impl::skin_targets(double time) {
   drive_.skin(mesh_, time);
 }
 
 void SkinnedSoftBody::Impl::set_pinned(std::span<const std::int32_t> vertices) {
+  check_editable("set_pinned");
+  for (const auto v : vertices)
+    if (v < 0 || v >= vertex_count())
+      throw std::invalid_argument("SkinnedSoftBody::set_pinned: vertex " + std::to_string(v) +
+                                  " out of range [0, " + std::to_string(vertex_count()) + ")");
   std::fill(pinned_.begin(), pinned_.end(), 0);
   for (const auto v : vertices) pinned_.at(static_cast<std::size_t>(v)) = 1;
   for (std::int32_t v = 0; v < vertex_count(); ++v) {
     const auto i = static_cast<std::size_t>(v);
+    const std::int32_t p = piece_of_[i];
+    if (p >= 0 && pieces_[static_cast<std::size_t>(p)]->released) continue;  // free for good
     const bool k = pinned_[i] || is_kinematic_by_weight(v);
     if (k == bool(kinematic_[i])) continue;
     kinematic_[i] = k;

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -40,8 +41,21 @@ class SkinDrive {
   /// A substep's start: the targets become the previous ones, then skin(time); a vertex added
   /// since gets its target as its previous one (zero target velocity).
   void advance(const mesh::SkinnedMesh& mesh, double time);
+  /// After an edit added vertices: their targets now (the last pose, the source not asked
+  /// again), their previous targets equal to them, so that target(v) is valid at once.
+  void extend(const mesh::SkinnedMesh& mesh);
+  /// The targets at `time` become the previous ones too (zero target velocity).
+  void settle(const mesh::SkinnedMesh& mesh, double time) {
+    skin(mesh, time);
+    previous_ = target_;
+  }
 
   const skin::SoaPoints<double>& targets() const { return target_; }
+  /// Where the skinned (model-space) targets are placed in the world.
+  void set_transform(const Eigen::Isometry3d& transform) { transform_ = transform; }
+  const Eigen::Isometry3d& transform() const { return transform_; }
+  /// The pose of the last skinning (the rest pose before the first).
+  const skin::Pose& pose() const { return pose_; }
   const skin::SoaPoints<double>& previous_targets() const { return previous_; }
   Eigen::Vector3d target(std::int32_t v) const {
     const auto i = static_cast<std::size_t>(v);
@@ -62,6 +76,8 @@ class SkinDrive {
   // substep's start swaps the two buffers.
   skin::SoaPoints<double> target_, previous_;
   bool fill_previous_ = false;  // vertices were added: their previous targets are NaN
+  Eigen::Isometry3d transform_ = Eigen::Isometry3d::Identity();
+  void place();  // transform_ applied to the targets just skinned
   int threads_ = 1;
 };
 

@@ -60,13 +60,33 @@ void validate(const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton) {
 }
 
 void validate(const Material& material) {
-  require(material.pretension >= 0 && material.pretension < 1, "pretension", material.pretension,
-          "[0, 1)");
-  require(material.density > 0, "density", material.density, "> 0");
-  require(material.link_stiffness > 0 && material.link_stiffness <= 1, "link_stiffness",
-          material.link_stiffness, "(0, 1]");
-  require(material.bending_stiffness >= 0 && material.bending_stiffness <= 1, "bending_stiffness",
-          material.bending_stiffness, "[0, 1]");
+  const auto finite = [](double v) { return std::isfinite(v); };
+  const auto model = static_cast<int>(material.model);
+  require(model == static_cast<int>(MaterialModel::membrane) ||
+              model == static_cast<int>(MaterialModel::bullet_links),
+          "model", model, "membrane (0) or bullet_links (1)");
+  require(finite(material.link_stiffness) && material.link_stiffness > 0 &&
+              material.link_stiffness <= 1,
+          "link_stiffness", material.link_stiffness, "(0, 1]");
+  require(finite(material.damping) && material.damping >= 0 && material.damping < 1, "damping",
+          material.damping, "[0, 1)");
+  require(finite(material.pretension) && material.pretension >= 0 && material.pretension < 1,
+          "pretension", material.pretension, "[0, 1)");
+  require(finite(material.density) && material.density > 0, "density", material.density,
+          "> 0 kg/m^2");
+  require(finite(material.target_stiffness) && material.target_stiffness >= 0, "target_stiffness",
+          material.target_stiffness, ">= 0 1/s^2");
+  require(finite(material.target_damping) && material.target_damping >= 0, "target_damping",
+          material.target_damping, ">= 0 1/s");
+  require(finite(material.kinematic_weight) && material.kinematic_weight > 0, "kinematic_weight",
+          material.kinematic_weight, "> 0 (> 1: none by weight)");
+  require(material.position_iterations >= 1 && material.position_iterations <= 1000,
+          "position_iterations", material.position_iterations, "[1, 1000]");
+  require(finite(material.bending_stiffness) && material.bending_stiffness >= 0 &&
+              material.bending_stiffness <= 1,
+          "bending_stiffness", material.bending_stiffness, "[0, 1]");
+  require(finite(material.margin) && material.margin >= 0 && material.margin <= 1, "margin",
+          material.margin, "[0, 1] m");
   if (material.model == MaterialModel::membrane) {
     material.skin.validate();  // throws naming the field and its value
     material.solver.validate();
@@ -95,16 +115,19 @@ std::vector<double> vertex_masses(const mesh::SkinnedMesh& mesh, double density)
 
 }  // namespace
 
-SkinnedSoftBody::Impl::Impl(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
-                            std::function<void(btSoftBody*)> remove, const mesh::SkinnedMesh& mesh,
-                            const skin::Skeleton& skeleton, const Material& material)
-    : info_(&info),
-      add_(std::move(add)),
-      remove_(std::move(remove)),
+SkinnedSoftBody::Impl::Impl(const WorldLink& link, const mesh::SkinnedMesh& mesh,
+                            const skin::Skeleton& skeleton, const Material& material,
+                            const PieceSettings& settings)
+    : info_(link.info),
+      link_(link),
+      defaults_(settings),
       mesh_(mesh),
       skeleton_(skeleton),
       material_(material),
       drive_(skeleton_) {
+  if (!info_ || !link_.add || !link_.remove)
+    throw std::invalid_argument(
+        "SkinnedSoftBody: the world link lacks its world info, add or remove");
   validate(mesh_, skeleton_);
   validate(material_);
   if (membrane_model()) material_.density = material_.skin.areal_density;  // the books' masses
@@ -121,8 +144,22 @@ SkinnedSoftBody::Impl::Impl(btSoftBodyWorldInfo& info, std::function<void(btSoft
 }
 
 SkinnedSoftBody::Impl::~Impl() {
+  // A body in a world has a broadphase handle; one whose world was destroyed first has none
+  // (Bullet's world destructor clears them) and is deleted without touching the world. Bodies
+  // the application deleted are gone from the books already (PieceBody).
   for (auto& piece : pieces_)
-    if (piece) remove_(piece->body.get());
+    if (piece && piece->body && piece->body->getBroadphaseHandle()) link_.remove(piece->body.get());
+  events_.clear();
+  for (auto& listener : listeners_) listener({PieceEvent::Kind::body_destroyed, {}, {}});
+}
+
+void SkinnedSoftBody::Impl::play(const skin::Animation& animation, skin::Blend blend, bool loop) {
+  // Sampling trusts the channels' joint ids: a foreign animation would write past the pose.
+  const std::string problem = animation.validate(skeleton_);
+  if (!problem.empty())
+    throw std::invalid_argument("SkinnedSoftBody::play: animation '" + animation.name +
+                                "' does not fit the skeleton: " + problem);
+  drive_.play(animation, blend, loop);
 }
 
 bool SkinnedSoftBody::Impl::is_kinematic_by_weight(std::int32_t v) const {
@@ -130,12 +167,14 @@ bool SkinnedSoftBody::Impl::is_kinematic_by_weight(std::int32_t v) const {
 }
 
 void SkinnedSoftBody::Impl::apply(const mesh::TopologyChange& change) {
+  check_editable("apply");
   stats_ = {};
   double clock = thread_seconds();
   mesh::apply(mesh_, change, &adjacency_);
   face_index_.update(mesh_, change);
   stats_.seconds.mesh += seconds_since(clock);
   mirror(change);
+  drive_.extend(mesh_);
 }
 
 void SkinnedSoftBody::Impl::sync_mesh() {
@@ -145,6 +184,7 @@ void SkinnedSoftBody::Impl::sync_mesh() {
 
 mesh::CutResult SkinnedSoftBody::Impl::cut(const cga::Plane<double>& plane,
                                            const mesh::CutOptions& options) {
+  check_editable("cut");
   stats_ = {};
   double clock = thread_seconds();
   sync_mesh();
@@ -159,6 +199,7 @@ mesh::CutResult SkinnedSoftBody::Impl::cut(const cga::Plane<double>& plane,
 
 mesh::DrillResult SkinnedSoftBody::Impl::drill(const mesh::DrillTool& tool,
                                                const mesh::DrillOptions& options) {
+  check_editable("drill");
   stats_ = {};
   double clock = thread_seconds();
   sync_mesh();
@@ -166,14 +207,17 @@ mesh::DrillResult SkinnedSoftBody::Impl::drill(const mesh::DrillTool& tool,
   mesh::DrillResult result = mesh::drill(mesh_, adjacency_, face_index_, tool, options);
   stats_.seconds.mesh = seconds_since(clock);
   for (const auto& change : result.changes) mirror(change);
+  drive_.extend(mesh_);
   return result;
 }
 
 void SkinnedSoftBody::Impl::begin_tear(const mesh::TearOptions& options) {
+  check_editable("begin_tear");
   tear_ = std::make_unique<mesh::Tear>(mesh_, adjacency_, face_index_, options);
 }
 
 mesh::TearStep SkinnedSoftBody::Impl::tear_advance(const mesh::ScalpelSample& sample) {
+  check_editable("tear_advance");
   if (!tear_) begin_tear();
   stats_ = {};
   double clock = thread_seconds();
@@ -182,26 +226,28 @@ mesh::TearStep SkinnedSoftBody::Impl::tear_advance(const mesh::ScalpelSample& sa
   mesh::TearStep step = tear_->advance(sample);
   stats_.seconds.mesh = seconds_since(clock);
   for (const auto& change : step.changes) mirror(change);
+  drive_.extend(mesh_);
   return step;
 }
 
 // --- Queries ---
 
 std::int32_t SkinnedSoftBody::Impl::piece_count() const {
-  return std::int32_t(std::count_if(pieces_.begin(), pieces_.end(),
-                                    [](auto& p) { return p && p->body->m_faces.size() > 0; }));
+  return std::int32_t(std::count_if(pieces_.begin(), pieces_.end(), [](auto& p) {
+    return p && p->body && p->body->m_faces.size() > 0;
+  }));
 }
 
 std::vector<btSoftBody*> SkinnedSoftBody::Impl::pieces() const {
   std::vector<btSoftBody*> out;
   for (const auto& p : pieces_)
-    if (p) out.push_back(p->body.get());
+    if (p && p->body) out.push_back(p->body.get());
   return out;
 }
 
 std::int32_t SkinnedSoftBody::Impl::vertex_of(const btSoftBody* body, int node) const {
   for (const auto& p : pieces_)
-    if (p && p->body.get() == body)
+    if (p && p->body && p->body.get() == body)
       return node >= 0 && std::size_t(node) < p->node_vertex.size()
                  ? p->node_vertex[std::size_t(node)]
                  : -1;
@@ -247,7 +293,7 @@ double SkinnedSoftBody::Impl::bending_rest_length(std::int32_t u, std::int32_t v
 std::int32_t SkinnedSoftBody::Impl::link_count() const {
   std::int32_t n = 0;
   for (const auto& p : pieces_)
-    if (p) n += p->body->m_links.size() - p->bending;
+    if (p && p->body) n += p->body->m_links.size() - p->bending;
   return n;
 }
 
@@ -260,12 +306,12 @@ std::int32_t SkinnedSoftBody::Impl::bending_link_count() const {
 
 // --- SkinnedSoftBody: forwards to its Impl ---
 
-SkinnedSoftBody::SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
-                                 std::function<void(btSoftBody*)> remove,
-                                 const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton,
-                                 const Material& material)
-    : impl_(std::make_unique<Impl>(info, std::move(add), std::move(remove), mesh, skeleton,
-                                   material)) {}
+SkinnedSoftBody::SkinnedSoftBody(const WorldLink& link, const mesh::SkinnedMesh& mesh,
+                                 const skin::Skeleton& skeleton, const Material& material,
+                                 const PieceSettings& settings)
+    : impl_(std::make_unique<Impl>(link, mesh, skeleton, material, settings)) {
+  impl_->events_.clear();  // the pieces made here are listed by piece_ids(), not announced
+}
 SkinnedSoftBody::~SkinnedSoftBody() = default;
 
 void SkinnedSoftBody::set_pose(const skin::Pose& pose) {
@@ -280,6 +326,28 @@ void SkinnedSoftBody::set_keyframes(skin::PoseTrack track, skin::Blend blend) {
 void SkinnedSoftBody::set_pose_source(std::function<void(double, skin::Pose&)> source) {
   impl_->set_pose_source(std::move(source));
 }
+void SkinnedSoftBody::set_world_transform(const Eigen::Isometry3d& transform) {
+  if (!transform.matrix().allFinite())
+    throw std::invalid_argument("SkinnedSoftBody::set_world_transform: non-finite transform");
+  const Eigen::Matrix3d r = transform.linear();
+  if (!(r.transpose() * r).isIdentity(1e-9) || r.determinant() < 0)
+    throw std::invalid_argument(
+        "SkinnedSoftBody::set_world_transform: the linear part is not a rotation (a rigid "
+        "transform is needed: scale the mesh instead)");
+  impl_->drive_.set_transform(transform);
+}
+const Eigen::Isometry3d& SkinnedSoftBody::world_transform() const {
+  return impl_->drive_.transform();
+}
+void SkinnedSoftBody::set_clock(const Clock& clock) {
+  impl_->set_clock(clock);
+}
+double SkinnedSoftBody::clock_time() const {
+  return impl_->clock_now_;
+}
+void SkinnedSoftBody::snap_to_pose() {
+  impl_->snap_to_pose();
+}
 void SkinnedSoftBody::set_skin_threads(int threads) {
   impl_->set_skin_threads(threads);
 }
@@ -289,23 +357,30 @@ void SkinnedSoftBody::set_pinned(std::span<const std::int32_t> vertices) {
 
 mesh::CutResult SkinnedSoftBody::cut(const cga::Plane<double>& plane,
                                      const mesh::CutOptions& options) {
-  return impl_->cut(plane, options);
+  auto result = impl_->cut(plane, options);
+  impl_->deliver_events();
+  return result;
 }
 mesh::DrillResult SkinnedSoftBody::drill(const mesh::DrillTool& tool,
                                          const mesh::DrillOptions& options) {
-  return impl_->drill(tool, options);
+  auto result = impl_->drill(tool, options);
+  impl_->deliver_events();
+  return result;
 }
 void SkinnedSoftBody::begin_tear(const mesh::TearOptions& options) {
   impl_->begin_tear(options);
 }
 mesh::TearStep SkinnedSoftBody::tear_advance(const mesh::ScalpelSample& sample) {
-  return impl_->tear_advance(sample);
+  auto step = impl_->tear_advance(sample);
+  impl_->deliver_events();
+  return step;
 }
 const mesh::Tear* SkinnedSoftBody::tear() const {
   return impl_->tear();
 }
 void SkinnedSoftBody::apply(const mesh::TopologyChange& change) {
   impl_->apply(change);
+  impl_->deliver_events();
 }
 const ApplyStats& SkinnedSoftBody::last_apply() const {
   return impl_->last_apply();
@@ -385,6 +460,53 @@ bool SkinnedSoftBody::detached(std::int32_t vertex) const {
 }
 std::int32_t SkinnedSoftBody::detached_count() const {
   return impl_->detached_count();
+}
+
+std::vector<PieceId> SkinnedSoftBody::piece_ids() const {
+  return impl_->piece_ids();
+}
+bool SkinnedSoftBody::piece_valid(PieceId id) const {
+  return impl_->piece_valid(id);
+}
+btSoftBody* SkinnedSoftBody::piece_body(PieceId id) const {
+  return impl_->piece_body(id);
+}
+PieceId SkinnedSoftBody::piece_of(std::int32_t vertex) const {
+  return impl_->piece_of(vertex);
+}
+void SkinnedSoftBody::on_piece_event(std::function<void(const PieceEvent&)> listener) {
+  impl_->on_piece_event(std::move(listener));
+}
+const PieceSettings& SkinnedSoftBody::piece_settings(PieceId id) const {
+  return impl_->piece_settings(id);
+}
+void SkinnedSoftBody::set_piece_user(PieceId id, void* user) {
+  impl_->set_piece_user(id, user);
+}
+void SkinnedSoftBody::set_piece_collision(PieceId id, int group, int mask) {
+  impl_->set_piece_collision(id, group, mask);
+}
+void SkinnedSoftBody::release_piece(PieceId id, const ReleaseOptions& options) {
+  impl_->release_piece(id, options);
+}
+bool SkinnedSoftBody::piece_released(PieceId id) const {
+  return impl_->piece_released(id);
+}
+
+std::uint64_t SkinnedSoftBody::topology_version() const {
+  return impl_->topology_version_;
+}
+Eigen::Matrix3Xd SkinnedSoftBody::normals() const {
+  return impl_->normals();
+}
+const skin::Pose& SkinnedSoftBody::pose() const {
+  return impl_->drive_.pose();
+}
+std::vector<skin::Versor> SkinnedSoftBody::joint_transforms() const {
+  return impl_->joint_transforms();
+}
+void SkinnedSoftBody::debug_draw(btIDebugDraw& drawer) const {
+  impl_->debug_draw(drawer);
 }
 
 void SkinnedSoftBody::update(double dt, double time) {

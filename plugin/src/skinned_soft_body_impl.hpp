@@ -5,14 +5,18 @@
 //   skin_drive.cpp         pose source, skinned targets, the per-substep update;
 //   bullet_surgery.cpp     add/remove of nodes, faces and links, link constants, node areas;
 //   piece_books.cpp        bodies per piece, moving a piece, detaching, kept rest lengths;
-//   topology_mirror.cpp    a TopologyChange into Bullet, in phases over a MirrorContext.
+//   topology_mirror.cpp    a TopologyChange into Bullet, in phases over a MirrorContext;
+//   piece_handles.cpp      piece ids, events, per-piece settings, the edit guard;
+//   piece_release.cpp      releasing a piece from skinning (a free Bullet soft body).
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
+#include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -33,9 +37,8 @@ struct MirrorContext;
 
 struct SkinnedSoftBody::Impl {
   // The public methods, documented in skinned_soft_body.hpp.
-  Impl(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
-       std::function<void(btSoftBody*)> remove, const mesh::SkinnedMesh& mesh,
-       const skin::Skeleton& skeleton, const Material& material);
+  Impl(const WorldLink& link, const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton,
+       const Material& material, const PieceSettings& settings);
   ~Impl();
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
@@ -43,9 +46,7 @@ struct SkinnedSoftBody::Impl {
   // --- Pose sources (the last one set wins). Time is the plugin's simulated time, s. ---
   void set_pose(const skin::Pose& pose) { drive_.set_pose(pose); }
   void play(const skin::Animation& animation, skin::Blend blend = skin::Blend::linear,
-            bool loop = true) {
-    drive_.play(animation, blend, loop);
-  }
+            bool loop = true);
   void set_keyframes(skin::PoseTrack track, skin::Blend blend = skin::Blend::linear) {
     drive_.set_keyframes(std::move(track), blend);
   }
@@ -53,6 +54,8 @@ struct SkinnedSoftBody::Impl {
     drive_.set_pose_source(std::move(source));
   }
   void set_skin_threads(int threads) { drive_.set_threads(threads); }
+  void set_clock(const Clock& clock);
+  void snap_to_pose();
   void set_pinned(std::span<const std::int32_t> vertices);
 
   // --- Topology changes: on the simulated positions, only between stepSimulation calls. ---
@@ -77,6 +80,7 @@ struct SkinnedSoftBody::Impl {
   double mass(std::int32_t vertex) const { return mass_[static_cast<std::size_t>(vertex)]; }
   bool kinematic(std::int32_t vertex) const { return kinematic_[static_cast<std::size_t>(vertex)]; }
   inline btSoftBody* body_of(std::int32_t vertex) const;
+  inline const btSoftBody::Node& node(std::int32_t vertex) const;
   std::int32_t vertex_of(const btSoftBody* body, int node) const;
   std::int32_t node_of(std::int32_t vertex) const {
     return node_of_[static_cast<std::size_t>(vertex)];
@@ -95,10 +99,42 @@ struct SkinnedSoftBody::Impl {
   std::int32_t detached_count() const { return detached_count_; }
   bool is_kinematic_by_weight(std::int32_t vertex) const;
 
+  // --- Piece handles, events, settings, edit guard (piece_handles.cpp) ---
+  std::vector<PieceId> piece_ids() const;
+  bool piece_valid(PieceId id) const;
+  btSoftBody* piece_body(PieceId id) const;
+  PieceId piece_of(std::int32_t vertex) const;
+  PieceId id_of_slot(std::int32_t slot) const;
+  void on_piece_event(std::function<void(const PieceEvent&)> listener);
+  const PieceSettings& piece_settings(PieceId id) const;
+  void set_piece_user(PieceId id, void* user);
+  void set_piece_collision(PieceId id, int group, int mask);
+  bool piece_released(PieceId id) const;
+  struct Piece;      // piece_books.hpp
+  struct PieceBody;  // piece_books.hpp
+  /// The live piece `id` names; throws std::invalid_argument naming `what` when stale.
+  Piece& live_piece(PieceId id, const char* what) const;
+  /// Throws std::logic_error when an edit named `what` may not run now: inside a step, or
+  /// after the application deleted a piece's body.
+  void check_editable(const char* what) const;
+  /// Hands the events queued by the last edit to the listeners.
+  void deliver_events();
+  /// Called by a PieceBody the application deletes.
+  void body_deleted_by_app(std::int32_t slot);
+  // --- Render data (render_data.cpp) ---
+  Eigen::Matrix3Xd normals() const;
+  std::vector<skin::Versor> joint_transforms() const;
+  void debug_draw(btIDebugDraw& drawer) const;
+  // --- Release (piece_release.cpp) ---
+  void release_piece(PieceId id, const ReleaseOptions& options);
+  void release_nodes(Piece& piece);
+  /// After an edit: released pieces' new nodes are free too, and a volume-keeping piece whose
+  /// nodes changed keeps the volume it has now.
+  void refresh_released();
+
   // --- Skin drive (skin_drive.cpp): update() is the one per-substep entry point ---
   void update(double dt, double time);
   void skin_targets(double time);
-  struct Piece;  // piece_books.hpp
   void drive_nodes(Piece& piece, double dt);
   // The membrane (Material::model == membrane) replaces drive_nodes and the rest lengths.
   bool membrane_model() const { return material_.model == MaterialModel::membrane; }
@@ -107,7 +143,9 @@ struct SkinnedSoftBody::Impl {
 
   // --- Piece books (piece_books.cpp) ---
   struct PieceMove;  // piece_books.hpp
-  Piece& new_piece();
+  /// A new, empty piece in the world; its settings from `parent` (a slot; −1: the defaults).
+  Piece& new_piece(std::int32_t parent = -1);
+  void configure_body(btSoftBody& body, const Piece* parent);
   void build(const mesh::SkinnedMesh& mesh);
   void reserve_books(const mesh::SkinnedMesh& mesh);
   void index_faces(const mesh::SkinnedMesh& mesh);
@@ -170,7 +208,8 @@ struct SkinnedSoftBody::Impl {
   void refresh_changed_areas(MirrorContext& c);
 
   btSoftBodyWorldInfo* info_;
-  std::function<void(btSoftBody*)> add_, remove_;
+  WorldLink link_;
+  PieceSettings defaults_;  // of the pieces made at construction
   mesh::SkinnedMesh mesh_;
   mesh::Adjacency adjacency_;
   // Tear starts and drills query it; synced positions only mark it moved, so its refit is paid
@@ -222,6 +261,14 @@ struct SkinnedSoftBody::Impl {
   std::vector<std::pair<std::int32_t, std::int32_t>> bend_dirty_;
 
   std::vector<std::unique_ptr<Piece>> pieces_;  // null once emptied
+  std::vector<std::uint32_t> generation_;       // per slot; changes when its piece is removed
+  std::vector<std::function<void(const PieceEvent&)>> listeners_;
+  std::vector<PieceEvent> events_;      // queued during an edit, delivered after it
+  std::string lost_;                    // why the body is unusable (a piece deleted by the app)
+  double time_ = 0;                     // of the last substep (targets after an edit)
+  std::uint64_t topology_version_ = 0;  // changes mirrored
+  std::optional<Clock> clock_;          // the body's own animation clock, when set
+  double clock_now_ = 0;                // the time the pose source was last sampled at
   ApplyStats stats_;
 };
 

@@ -25,6 +25,7 @@ void erase_value(std::vector<std::int32_t>& list, std::int32_t value) {
 }  // namespace
 
 void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
+  ++topology_version_;
   membrane_.invalidate();  // rebuilt from the rest mesh at the next substep
   const double start = thread_seconds();
   const std::int32_t v0 = change.base_vertex_count;
@@ -49,6 +50,7 @@ void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
   if (c.bending) refresh_changed_bending();
   refresh_changed_areas(c);
   drop_empty_pieces();
+  refresh_released();
   clear_kept();
   bend_dirty_.clear();
   split_.clear();
@@ -314,7 +316,7 @@ void SkinnedSoftBody::Impl::place_changed_nodes(MirrorContext& c) {
     if (group != mesh::SplitSearch::kOpen) {
       auto& o = c.owner[static_cast<std::size_t>(group)];
       if (o < 0) {
-        new_piece();
+        new_piece(c.open_body);
         o = std::int32_t(pieces_.size()) - 1;
       }
       p = o;

@@ -8,6 +8,20 @@
 //   skin.set_keyframes(track);                       // or play(animation), set_pose_source(rig)
 //   world.stepSimulation(1.0 / 60);                  // skinning drives the soft body
 //   skin.cut(plane);                                 // between steps
+//
+// Ownership and lifetime: the plugin owns its skinned bodies and they own their pieces'
+// btSoftBody objects (skinned_soft_body.hpp). The plugin adds one action and one inert guard
+// object (a btCollisionObject with an empty shape, broadphase group and mask 0: it collides
+// with nothing) to the world; the guard tells the plugin, when it is destroyed, whether the
+// world still exists. Both teardown orders are safe: Bullet's standard one (the application
+// removes and deletes every soft body, or every collision object, then destroys the plugin),
+// and the world destroyed before the plugin. The world's memory itself must not be reused for
+// another world before the plugin goes. The application must not remove the guard from the
+// world without deleting it.
+//
+// Threading: a plugin and its bodies are used from the thread that steps the world, between
+// stepSimulation calls (edits inside a step throw std::logic_error); distinct plugins on
+// distinct worlds may run on distinct threads.
 #pragma once
 
 #include <functional>
@@ -46,16 +60,25 @@ class Plugin {
   /// Adds a CGA-skinned soft body built from `mesh` (its current positions) and `skeleton`.
   /// Throws std::logic_error when the world has no soft bodies, std::invalid_argument on bad
   /// input. The body lives as long as the plugin (or until remove_skinned_body).
+  /// `settings` (user pointer, collision group and mask, btSoftBody::Config template) apply
+  /// to every piece made now, and pieces split later inherit them from their parent.
   SkinnedSoftBody& add_skinned_body(const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton,
-                                    const Material& material = {});
-  SkinnedSoftBody& add_skinned_body(const io::SkinnedModel& model, const Material& material = {});
+                                    const Material& material = {},
+                                    const PieceSettings& settings = {});
+  SkinnedSoftBody& add_skinned_body(const io::SkinnedModel& model, const Material& material = {},
+                                    const PieceSettings& settings = {});
   void remove_skinned_body(SkinnedSoftBody& body);
   std::size_t skinned_body_count() const;
 
  private:
   struct Action;
+  struct Guard;
+  /// Whether the world is still there (the guard's broadphase handle survives only in it).
+  bool world_alive() const;
   btDynamicsWorld* world_;
   std::unique_ptr<Action> action_;
+  std::unique_ptr<Guard> guard_;
+  bool guard_deleted_ = false;  // the application deleted the guard (it deletes every object)
 };
 
 }  // namespace conform::bullet

@@ -31,12 +31,14 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
 #include <memory>
 #include <span>
 #include <vector>
 
+#include "conform/bullet/piece.hpp"
 #include "conform/cga/plane.hpp"
 #include "conform/membrane/skin_material.hpp"
 #include "conform/membrane/solver.hpp"
@@ -50,6 +52,7 @@
 #include "conform/skin/skeleton.hpp"
 
 class btSoftBody;
+class btIDebugDraw;
 struct btSoftBodyWorldInfo;
 
 namespace conform::bullet {
@@ -104,6 +107,16 @@ struct Material {
   membrane::SolverSettings solver{};
 };
 
+/// How a skinned body reaches its world (Plugin::add_skinned_body makes one).
+struct WorldLink {
+  btSoftBodyWorldInfo* info = nullptr;
+  /// Adds a piece's body to the world with its broadphase group and mask.
+  std::function<void(btSoftBody*, int group, int mask)> add{};
+  std::function<void(btSoftBody*)> remove{};
+  /// True while the world steps: edits are then refused (empty: never).
+  std::function<bool()> stepping{};
+};
+
 /// What one applied TopologyChange did to the Bullet side.
 struct ApplyStats {
   std::int32_t new_nodes = 0;
@@ -134,11 +147,12 @@ struct ApplyStats {
 class SkinnedSoftBody {
  public:
   /// Builds the pieces of `mesh` (its `current` positions are the initial node positions) and
-  /// adds them to the world through `add`. `skeleton` is copied. Throws std::invalid_argument
-  /// on inconsistent input. Normally made by Plugin::add_skinned_body.
-  SkinnedSoftBody(btSoftBodyWorldInfo& info, std::function<void(btSoftBody*)> add,
-                  std::function<void(btSoftBody*)> remove, const mesh::SkinnedMesh& mesh,
-                  const skin::Skeleton& skeleton, const Material& material);
+  /// adds them to the world through `link.add`, each with `settings`. `skeleton` is copied.
+  /// Throws std::invalid_argument on inconsistent input. Normally made by
+  /// Plugin::add_skinned_body.
+  SkinnedSoftBody(const WorldLink& link, const mesh::SkinnedMesh& mesh,
+                  const skin::Skeleton& skeleton, const Material& material,
+                  const PieceSettings& settings = {});
   ~SkinnedSoftBody();
   SkinnedSoftBody(const SkinnedSoftBody&) = delete;
   SkinnedSoftBody& operator=(const SkinnedSoftBody&) = delete;
@@ -147,12 +161,35 @@ class SkinnedSoftBody {
   /// A fixed pose.
   void set_pose(const skin::Pose& pose);
   /// An animation sampled at the simulated time (wrapped when `loop`). The animation is copied.
+  /// Throws std::invalid_argument when it does not fit the skeleton (Animation::validate).
   void play(const skin::Animation& animation, skin::Blend blend = skin::Blend::linear,
             bool loop = true);
   /// Keyframes set by the user, sampled at the simulated time.
   void set_keyframes(skin::PoseTrack track, skin::Blend blend = skin::Blend::linear);
   /// Any other source, e.g. an arm rig: writes the pose for `time` into `pose`.
   void set_pose_source(std::function<void(double time, skin::Pose& pose)> source);
+  /// Where the body is in the world: the skinned targets (model space, as the mesh and the
+  /// skeleton) are placed by this rigid transform (default identity) from the next substep
+  /// on; the nodes follow through the drive, or at once with snap_to_pose(). Positions,
+  /// targets, cut planes, tear samples and drill tools are in world space; mesh().rest stays
+  /// in model space.
+  void set_world_transform(const Eigen::Isometry3d& transform);
+  const Eigen::Isometry3d& world_transform() const;
+  /// The body's own animation clock (opt-in): from this call on, the pose source is sampled at
+  /// start + speed × (simulated time since the call), frozen while paused (call again to
+  /// change speed or to pause; `start` then restarts it). Without it: the plugin's time.
+  struct Clock {
+    double start = 0;  // s
+    double speed = 1;  // finite; negative runs backwards
+    bool paused = false;
+  };
+  void set_clock(const Clock& clock);
+  /// The time the pose source was last sampled at, s.
+  double clock_time() const;
+  /// Places every node in Bullet on its skinned target at the current time, at rest (position
+  /// = target, velocity 0). Call after choosing the pose source and before stepping, so that
+  /// the first substep does not jump from the bind pose to the source's first pose.
+  void snap_to_pose();
   /// OpenMP threads of the skinning loop; 0 = the library's choice. Default 1: a fork/join
   /// every substep costs more than it saves on a few thousand vertices, and idle OpenMP
   /// workers spinning on the second core slowed each Bullet step by 3-7× in our measurements.
@@ -161,7 +198,10 @@ class SkinnedSoftBody {
   /// above the weight threshold).
   void set_pinned(std::span<const std::int32_t> vertices);
 
-  // --- Topology changes: on the simulated positions, only between stepSimulation calls. ---
+  // --- Topology changes: on the simulated positions, only between stepSimulation calls (an
+  // edit from the plugin's action, i.e. a step hook or a pose source, throws
+  // std::logic_error; one from the application's own internal tick callback is not detected).
+  // Every query below is valid right after an edit, new vertices included. ---
   mesh::CutResult cut(const cga::Plane<double>& plane, const mesh::CutOptions& options = {});
   mesh::DrillResult drill(const mesh::DrillTool& tool, const mesh::DrillOptions& options = {});
   /// Starts a tear (replacing any earlier one); advance it with tear_advance().
@@ -171,6 +211,26 @@ class SkinnedSoftBody {
   /// Applies a change computed by the caller on mesh() (after sync_mesh()).
   void apply(const mesh::TopologyChange& change);
   const ApplyStats& last_apply() const;
+
+  // --- Pieces: handles, events, inherited settings, release (piece.hpp) ---
+  /// The live pieces' ids (bodies holding nodes), in slot order.
+  std::vector<PieceId> piece_ids() const;
+  /// Whether `id` names a live piece of this body (false for a stale or null id).
+  bool piece_valid(PieceId id) const;
+  /// The live piece's btSoftBody, or null for a stale or null id.
+  btSoftBody* piece_body(PieceId id) const;
+  /// The piece holding `vertex` (null for a detached vertex).
+  PieceId piece_of(std::int32_t vertex) const;
+  /// Adds a listener of piece events (created, removed, body destroyed).
+  void on_piece_event(std::function<void(const PieceEvent&)> listener);
+  /// The piece's settings (throws std::invalid_argument for a stale id; so do the setters).
+  const PieceSettings& piece_settings(PieceId id) const;
+  void set_piece_user(PieceId id, void* user);
+  /// Re-adds the piece's body to the world with this broadphase group and mask.
+  void set_piece_collision(PieceId id, int group, int mask);
+  /// Releases the piece from skinning (ReleaseOptions); pieces split from it stay released.
+  void release_piece(PieceId id, const ReleaseOptions& options = {});
+  bool piece_released(PieceId id) const;
 
   // --- State ---
   /// The mesh with `current` = the simulated node positions as of the last sync_mesh().
@@ -215,6 +275,22 @@ class SkinnedSoftBody {
   /// and node_of() −1.
   bool detached(std::int32_t vertex) const;
   std::int32_t detached_count() const;
+
+  // --- Render data and pose (render_data.cpp) ---
+  /// Changes mirrored since construction: +1 per TopologyChange (a drill or tear step may
+  /// apply several). Face and vertex indices of mesh() may be reshuffled whenever it changes.
+  std::uint64_t topology_version() const;
+  /// Per vertex, the unit area-weighted normal of its faces at the simulated positions (zero
+  /// for a vertex without faces); #V by 3 columns as mesh().current.
+  Eigen::Matrix3Xd normals() const;
+  /// The skeleton pose of the last substep (local versors; the rest pose before the first).
+  const skin::Pose& pose() const;
+  /// The global versor of every joint for pose() (joint space → mesh space).
+  std::vector<skin::Versor> joint_transforms() const;
+  /// Draws the skeleton (joint to parent, yellow) and, for every driven node in Bullet, the
+  /// offset to its skinned target (cyan). Called by the plugin's action from
+  /// btDynamicsWorld::debugDrawWorld; Bullet draws the pieces themselves.
+  void debug_draw(btIDebugDraw& drawer) const;
 
   /// The membrane's solve of the last substep (residual in Pa, iterations); zero with
   /// bullet_links.
