@@ -1,8 +1,9 @@
 #include "sweep_slurm.hpp"
 
+#include <cctype>
+
 #include <cstdio>
 #include <fstream>
-#include <regex>
 
 namespace conform::scenes {
 
@@ -24,13 +25,34 @@ void check_word(const std::string& option, const std::string& value) {
     throw SceneError(option, "\"" + value + "\"", "must be one word (no spaces, quotes or #)");
 }
 
+// Slurm's time forms: MINUTES, MM:SS, HH:MM:SS, D-HH, D-HH:MM, D-HH:MM:SS — an optional
+// "DAYS-", then one to three groups of digits joined by ':'. (Not std::regex: GCC 12's
+// -Wmaybe-uninitialized fires inside <regex> in the sanitized build.)
+bool is_slurm_time(const std::string& t) {
+  std::size_t at = 0;
+  const auto digits = [&] {
+    const std::size_t from = at;
+    while (at < t.size() && std::isdigit(static_cast<unsigned char>(t[at]))) ++at;
+    return at > from;
+  };
+  if (const auto dash = t.find('-'); dash != std::string::npos) {
+    if (!digits() || at != dash) return false;
+    ++at;
+  }
+  for (int group = 0; group < 3; ++group) {
+    if (!digits()) return false;
+    if (at == t.size()) return true;
+    if (t[at++] != ':') return false;
+  }
+  return false;
+}
+
 }  // namespace
 
 void check_slurm_options(const SlurmOptions& options) {
   check_word("--partition", options.partition);
   check_word("--time", options.time);
-  if (!options.time.empty() &&
-      !std::regex_match(options.time, std::regex(R"((\d+-)?\d+(:\d+){0,2})")))
+  if (!options.time.empty() && !is_slurm_time(options.time))
     throw SceneError("--time", options.time,
                      "is not a Slurm time (MINUTES, HH:MM:SS, D-HH:MM:SS, ...)");
   if (options.array_limit < 0)
