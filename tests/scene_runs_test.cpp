@@ -131,6 +131,11 @@ TEST(SceneCharacter, RealModelPlaysItsAnimationAsASoftBody) {
   EXPECT_GT(m["kinematic_nodes"].get<int>(), 0);
   EXPECT_GT(m["secondary_motion_mean_m"].get<double>(), 0);   // the soft nodes do lag
   EXPECT_LT(m["secondary_motion_max_m"].get<double>(), 1.0);  // the model spans ~5 m
+  // No first-step spike: the body starts at the animation's first pose, so its fastest node
+  // after one step moves no faster than the animation moves the skin, plus what gravity adds
+  // in one step (g dt = 9.81 / 60 m/s).
+  EXPECT_LE(m["first_step_max_node_speed_m_s"].get<double>(),
+            m["first_step_max_target_speed_m_s"].get<double>() + 9.81 / 60);
 }
 
 }  // namespace
