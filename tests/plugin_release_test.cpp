@@ -96,24 +96,18 @@ Landing land(double voxel, const bullet::ReleaseOptions& release, int frames,
     body.release_piece(piece, release);
     btSoftBody& sb = *body.piece_body(piece);
     out.nodes = sb.m_nodes.size();
-    auto com = [&] {
+    // The mass-weighted mean of a node field: the centre of mass (m_x) or its velocity (m_v).
+    auto mass_mean = [&](btVector3 btSoftBody::Node::*field) {
       btVector3 c(0, 0, 0);
       btScalar m = 0;
       for (int i = 0; i < sb.m_nodes.size(); ++i) {
         const btScalar mi = 1 / sb.m_nodes[i].m_im;
-        c += sb.m_nodes[i].m_x * mi, m += mi;
+        c += sb.m_nodes[i].*field * mi, m += mi;
       }
       return c / m;
     };
-    auto com_velocity = [&] {
-      btVector3 c(0, 0, 0);
-      btScalar m = 0;
-      for (int i = 0; i < sb.m_nodes.size(); ++i) {
-        const btScalar mi = 1 / sb.m_nodes[i].m_im;
-        c += sb.m_nodes[i].m_v * mi, m += mi;
-      }
-      return c / m;
-    };
+    auto com = [&] { return mass_mean(&btSoftBody::Node::m_x); };
+    auto com_velocity = [&] { return mass_mean(&btSoftBody::Node::m_v); };
     out.height_before = extent(sb).height;
     out.volume_before = double(sb.getVolume());
     const double y0 = double(com().y());
