@@ -10,6 +10,7 @@
 
 #include "../tests/plugin_world.hpp"
 #include "conform/bullet/plugin.hpp"
+#include "conform/membrane/solver.hpp"
 #include "conform/mesh/primitives.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "ratio_reporter.hpp"
@@ -266,14 +267,16 @@ void BM_OpeningTearStep(benchmark::State& state) {
 }
 BENCHMARK(BM_OpeningTearStep)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
-// The default material against today's baseline (Bullet's links, the tear-opening scene's link
-// settings) in the same run: the arm of `resolution` (1: 2.6k vertices, 2: 10k), its forearm
-// torn open (40 samples) and settled, then one 1/60 s step of 2 substeps while the elbow
-// flexes (a moving pose, so the membrane solves every substep).
-// The torn arm of tear-opening, as a membrane (its scene defaults: one 1/60 s substep a frame;
-// `threads` OpenMP threads in the solver) or as Bullet's pre-tensioned links (the previous
-// default: two substeps of 1/120 s). torn: the stroke is done and the arm bends slowly, so
-// every frame solves; otherwise the clock runs over the stroke itself, one tear step a frame.
+// The default material against two baselines in the same run: Bullet's pre-tensioned links
+// (the tear-opening scene's link settings, the default before the membrane) and the membrane
+// at its previous solver settings (1 Pa, block-Jacobi CG). The arm of `resolution`
+// (1: 2.6k vertices, 2: 10k).
+enum Variant { kLinks = 0, kMembrane = 1, kMembranePrevious = 2 };
+
+// The torn arm of tear-opening (its scene defaults: one 1/60 s substep a frame for the
+// membrane; two substeps of 1/120 s for the links). BM_StepTornArm: the stroke is done and the
+// elbow flexes slowly, so every frame solves; BM_TearArm: the clock runs over the stroke itself,
+// an edit before every frame.
 struct TornArm {
   SoftWorld w;
   bullet::Plugin plugin{w.world};
@@ -281,11 +284,15 @@ struct TornArm {
   bool membrane;
   int next = 0;  // the next of the stroke's 40 samples
 
-  TornArm(bool membrane_model, int resolution, int threads) : membrane(membrane_model) {
+  TornArm(int variant, int resolution, int threads) : membrane(variant != kLinks) {
     const mesh::Arm arm = mesh::make_arm(resolution);
     bullet::Material material;
     material.solver.threads = threads;
-    if (!membrane)
+    if (variant == kMembranePrevious) {
+      material.solver.tolerance = 1.0;
+      material.solver.preconditioner = membrane::Preconditioner::block_jacobi;
+    }
+    if (variant == kLinks)
       material = {.model = bullet::MaterialModel::bullet_links,
                   .damping = 0.02,
                   .pretension = 0.2,
@@ -321,20 +328,22 @@ void report_solve(benchmark::State& state, const TornArm& a, double simulated_pe
 }
 
 void BM_StepTornArm(benchmark::State& state) {
-  TornArm a(state.range(0) == 1, int(state.range(1)), int(state.range(2)));
+  TornArm a(int(state.range(0)), int(state.range(1)), int(state.range(2)));
   a.tear(40);
   for (int i = 0; i < 30; ++i) a.frame();
   for (auto _ : state) a.frame();
   report_solve(state, a, 1.0 / 60);
 }
 BENCHMARK(BM_StepTornArm)
-    ->ArgNames({"membrane", "res", "threads"})
-    ->Args({1, 1, 1})
-    ->Args({1, 1, 2})
-    ->Args({0, 1, 1})
-    ->Args({1, 2, 1})
-    ->Args({1, 2, 2})
-    ->Args({0, 2, 1})
+    ->ArgNames({"variant", "res", "threads"})
+    ->Args({kMembrane, 1, 1})
+    ->Args({kMembrane, 1, 2})
+    ->Args({kMembranePrevious, 1, 1})
+    ->Args({kLinks, 1, 1})
+    ->Args({kMembrane, 2, 1})
+    ->Args({kMembrane, 2, 2})
+    ->Args({kMembranePrevious, 2, 1})
+    ->Args({kLinks, 2, 1})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
 
@@ -343,7 +352,7 @@ void BM_TearArm(benchmark::State& state) {
   std::unique_ptr<TornArm> a;
   for (auto _ : state) {
     state.PauseTiming();
-    a = std::make_unique<TornArm>(state.range(0) == 1, int(state.range(1)), int(state.range(2)));
+    a = std::make_unique<TornArm>(int(state.range(0)), int(state.range(1)), int(state.range(2)));
     a->frame();
     state.ResumeTiming();
     for (int f = 0; f < 30; ++f) {
@@ -354,32 +363,35 @@ void BM_TearArm(benchmark::State& state) {
   report_solve(state, *a, 0.5);
 }
 BENCHMARK(BM_TearArm)
-    ->ArgNames({"membrane", "res", "threads"})
-    ->Args({1, 1, 1})
-    ->Args({1, 1, 2})
-    ->Args({0, 1, 1})
-    ->Args({1, 2, 1})
-    ->Args({0, 2, 1})
+    ->ArgNames({"variant", "res", "threads"})
+    ->Args({kMembrane, 1, 1})
+    ->Args({kMembrane, 1, 2})
+    ->Args({kMembranePrevious, 1, 1})
+    ->Args({kLinks, 1, 1})
+    ->Args({kMembrane, 2, 1})
+    ->Args({kMembranePrevious, 2, 1})
+    ->Args({kLinks, 2, 1})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  for (const char* bench : {"BM_StepTornArm", "BM_TearArm"})
-    for (const char* r : {"1", "2"})
-      for (const char* t : {"1", "2"}) {
-        const std::string name = std::string(bench) + "/membrane:1/res:" + r + "/threads:" + t;
-        if (std::string(r) == "2" && std::string(t) == "2" && std::string(bench) == "BM_TearArm")
-          continue;
-        conform::bench::add_ratio(
-            name + "/min_time:2.000",
-            std::string(bench) + "/membrane:0/res:" + r + "/threads:1/min_time:2.000",
-            std::string("membrane (") + t + " thread" + (t[0] == '1' ? "" : "s") +
-                ") / Bullet links (the previous default), " +
-                (std::string(bench) == "BM_TearArm" ? "the stroke" : "torn arm") + ", resolution " +
-                r);
-      }
+  for (const std::string bench : {"BM_StepTornArm", "BM_TearArm"})
+    for (const std::string r : {"1", "2"}) {
+      const auto name = [&](int variant, const char* threads) {
+        return bench + "/variant:" + std::to_string(variant) + "/res:" + r + "/threads:" + threads +
+               "/min_time:2.000";
+      };
+      const std::string what =
+          (bench == "BM_TearArm" ? "the stroke" : "torn arm") + std::string(", resolution ") + r;
+      conform::bench::add_ratio(name(kMembrane, "1"), name(kMembranePrevious, "1"),
+                                "membrane / its previous settings (1 Pa, Jacobi), " + what);
+      conform::bench::add_ratio(name(kMembrane, "1"), name(kLinks, "1"),
+                                "membrane / Bullet links (the default before), " + what);
+      conform::bench::add_ratio(name(kMembrane, "2"), name(kMembrane, "1"),
+                                "membrane, 2 threads / 1 thread [wall], " + what, true);
+    }
   for (const char* s : {"5", "0"}) {
     const std::string base = std::string("BM_StepUnskinned/") + s + "/min_time:1.000";
     conform::bench::add_ratio(std::string("BM_StepSkinned/") + s + "/min_time:1.000", base,

@@ -34,6 +34,9 @@ void read_skin(Reader& r, const bullet::Material& d, bullet::Material& m) {
   m.solver.max_cg_iterations =
       r.integer("max_cg_iterations", d.solver.max_cg_iterations, 1, 1000000);
   m.solver.threads = r.integer("solver_threads", d.solver.threads, 1, 256);
+  m.solver.cg_relative_tolerance =
+      r.number("cg_relative_tolerance", d.solver.cg_relative_tolerance, 1e-6, 0.9);
+  m.solver.local_fraction = r.number("local_fraction", d.solver.local_fraction, 0, 0.99);
 }
 
 bullet::Material read_material(Reader& root, const bullet::Material& d) {

@@ -91,7 +91,7 @@ TEST(SceneTearOpening, OpensByPhysicsUnderPrestressOnly) {
 
   EXPECT_EQ(m["physics"]["material"], "membrane");
   EXPECT_EQ(m["physics"]["unconverged_substeps"].get<int>(), 0);
-  EXPECT_LE(m["physics"]["residual"].get<double>(), 1.0);  // Pa, the default tolerance
+  EXPECT_LE(m["physics"]["residual"].get<double>(), 100.0);  // Pa, the default tolerance
 
   const Json slack =
       run("tear-opening", "--set duration=2 --set material.prestress=[0,0]", "slack");

@@ -131,7 +131,7 @@ void Model::gradient(const Eigen::Ref<const Eigen::Matrix3Xd>& x,
   for (std::size_t e = 0; e < elements_.size(); ++e) {
     const mesh::Face& f = faces_[e];
     const detail::ElementState s =
-        detail::element_state(elements_[e], x.col(f[0]), x.col(f[1]), x.col(f[2]), lambda_, mu_);
+        detail::element_forces(elements_[e], x.col(f[0]), x.col(f[1]), x.col(f[2]), lambda_, mu_);
     for (int c = 0; c < 3; ++c)
       g.col(f[c]) += elements_[e].area_thickness * s.p * detail::beta_of(elements_[e], c);
   }

@@ -37,12 +37,15 @@ void SolverSettings::validate() const {
 }
 
 struct Solver::Scratch {
-  std::vector<detail::ElementState> states_;
+  std::vector<detail::ElementState> states_, trial_states_;  // trial_: of changed_ (line search)
   std::vector<Eigen::Matrix3d> node_stiffness_, block_inverse_, blocks_;
   std::vector<std::uint8_t> free_;    // per vertex: may move in this solve
   std::vector<std::uint8_t> active_;  // per vertex: moves in this Newton step (a subset of free_)
+  std::vector<std::int32_t> active_list_;        // the active vertices, ascending
+  std::vector<std::int32_t> changed_, touched_;  // elements with an active corner; their corners
+  std::vector<std::uint8_t> element_mark_, node_mark_;
   std::vector<std::int32_t> reached_, seed_of_;  // the active set's search (select_active)
-  Eigen::Matrix3Xd predicted_, gradient_, step_, r_, z_, p_, q_, trial_;
+  Eigen::Matrix3Xd predicted_, gradient_, step_, r_, z_, p_, q_, trial_, trial_direction_;
   Eigen::VectorXd inertia_weight_, node_residual_;
 };
 
@@ -66,6 +69,7 @@ struct Context {
   bool fixed(std::int64_t v) const {
     return in.fixed[static_cast<std::size_t>(v)] != 0 || model.node_area(std::int32_t(v)) <= 0;
   }
+  bool parallel() const { return threads > 1 && ne > kParallelElements; }
 };
 
 // Phase 1: nodal terms that do not change during the solve: attachment stiffness K_i and the
@@ -99,67 +103,64 @@ void prepare_nodes(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
   }
 }
 
-// Phase 2: per-element deformation gradient, stresses (parallel over elements).
-void evaluate_elements(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
-  const auto& elements = c.model.elements();
-  const auto& faces = c.model.element_faces();
-  c.s.states_.resize(elements.size());
-  const double lambda = c.model.lambda(), mu = c.model.mu();
-#pragma omp parallel for schedule(static) \
-    num_threads(c.threads) if (c.threads > 1 && c.ne > kParallelElements)
-  for (std::int64_t e = 0; e < c.ne; ++e) {
-    const mesh::Face& f = faces[static_cast<std::size_t>(e)];
-    c.s.states_[static_cast<std::size_t>(e)] = detail::element_state(
-        elements[static_cast<std::size_t>(e)], x.col(f[0]), x.col(f[1]), x.col(f[2]), lambda, mu);
-  }
+detail::ElementState forces_at(const Context& c, std::int64_t e,
+                               const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+  const mesh::Face& f = c.model.element_faces()[static_cast<std::size_t>(e)];
+  return detail::element_forces(c.model.elements()[static_cast<std::size_t>(e)], x.col(f[0]),
+                                x.col(f[1]), x.col(f[2]), c.model.lambda(), c.model.mu());
 }
 
-// Phi(x) (the membrane part from the element states of x).
-double potential(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
-  double total = c.model.energy(x);
-  for (std::int64_t v = 0; v < c.nv; ++v) {
-    if (c.fixed(v)) continue;
-    const Eigen::Vector3d d = x.col(v) - c.in.targets.col(v);
-    total += 0.5 * d.dot(c.s.node_stiffness_[static_cast<std::size_t>(v)] * d);
-    if (c.dynamic)
-      total += 0.5 * c.s.inertia_weight_[v] * (x.col(v) - c.s.predicted_.col(v)).squaredNorm();
-  }
+// Phase 2: every element's deformation gradient, stresses and energy density (parallel over
+// elements). After a Newton step only the changed elements are evaluated again (line_search).
+void evaluate_elements(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+  c.s.states_.resize(static_cast<std::size_t>(c.ne));
+#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
+  for (std::int64_t e = 0; e < c.ne; ++e)
+    c.s.states_[static_cast<std::size_t>(e)] = forces_at(c, e, x);
+}
+
+// The nodal part of Phi at node v: 1/2 d^T K d + 1/2 w |x - xp|^2 (d = x - T).
+double nodal_potential(const Context& c, std::int64_t v, const Eigen::Vector3d& x) {
+  const Eigen::Vector3d d = x - c.in.targets.col(v);
+  double total = 0.5 * d.dot(c.s.node_stiffness_[static_cast<std::size_t>(v)] * d);
+  if (c.dynamic) total += 0.5 * c.s.inertia_weight_[v] * (x - c.s.predicted_.col(v)).squaredNorm();
   return total;
 }
 
-// Phase 3: gradient of Phi at the evaluated states, zero at fixed nodes (gather per vertex).
-void gather_gradient(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x, Eigen::Matrix3Xd& g) {
-  const auto& elements = c.model.elements();
-  const auto& start = c.model.incidence_start();
-  const auto& inc = c.model.incidence();
-  g.resize(3, c.nv);
-#pragma omp parallel for schedule(static) \
-    num_threads(c.threads) if (c.threads > 1 && c.ne > kParallelElements)
-  for (std::int64_t v = 0; v < c.nv; ++v) {
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    if (!c.fixed(v)) {
-      for (std::int32_t k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
-        const std::int32_t e = inc[std::size_t(k)] / 3, corner = inc[std::size_t(k)] % 3;
-        sum += elements[std::size_t(e)].area_thickness * c.s.states_[std::size_t(e)].p *
-               detail::beta_of(elements[std::size_t(e)], corner);
-      }
-      sum += c.s.node_stiffness_[std::size_t(v)] * (x.col(v) - c.in.targets.col(v));
-      if (c.dynamic) sum += c.s.inertia_weight_[v] * (x.col(v) - c.s.predicted_.col(v));
-    }
-    g.col(v) = sum;
+// Phase 3: the gradient of Phi, g = sum_e A_e t P_e beta_a (scattered element by element:
+// sequential reads) + K_i (x_i - T_i) + w_i (x_i - xp_i), 0 at fixed nodes; and each node's
+// residual |g_i| / A_i (Pa).
+void scatter_element(Context& c, std::int64_t e, const detail::Mat32& p) {
+  const detail::ElementRest& rest = c.model.elements()[std::size_t(e)];
+  const mesh::Face& f = c.model.element_faces()[std::size_t(e)];
+  const Eigen::Vector3d f1 = rest.area_thickness * p * rest.beta.col(0),
+                        f2 = rest.area_thickness * p * rest.beta.col(1);
+  c.s.gradient_.col(f[0]) -= f1 + f2;
+  c.s.gradient_.col(f[1]) += f1;
+  c.s.gradient_.col(f[2]) += f2;
+}
+
+void node_residual(Context& c, std::int64_t v) {
+  if (!c.s.free_[std::size_t(v)]) {
+    c.s.gradient_.col(v).setZero();
+    c.s.node_residual_[v] = 0;
+  } else {
+    c.s.node_residual_[v] = c.s.gradient_.col(v).norm() / c.model.node_area(std::int32_t(v));
   }
 }
 
-// The residual of each free node (|g_i| / A_i, Pa; 0 at fixed nodes) and the largest.
-double residual(Context& c, const Eigen::Matrix3Xd& g) {
-  double worst = 0;
-  c.s.node_residual_.setZero(c.nv);
+void gradient_all(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+  Solver::Scratch& s = c.s;
+  s.gradient_.setZero(3, c.nv);
+  s.node_residual_.resize(c.nv);
+  for (std::int64_t e = 0; e < c.ne; ++e) scatter_element(c, e, s.states_[std::size_t(e)].p);
   for (std::int64_t v = 0; v < c.nv; ++v) {
-    if (!c.s.free_[std::size_t(v)]) continue;
-    c.s.node_residual_[v] = g.col(v).norm() / c.model.node_area(std::int32_t(v));
-    worst = std::max(worst, c.s.node_residual_[v]);
+    if (s.free_[std::size_t(v)]) {
+      s.gradient_.col(v) += s.node_stiffness_[std::size_t(v)] * (x.col(v) - c.in.targets.col(v));
+      if (c.dynamic) s.gradient_.col(v) += s.inertia_weight_[v] * (x.col(v) - s.predicted_.col(v));
+    }
+    node_residual(c, v);
   }
-  return worst;
 }
 
 // Phase 4: the nodes this Newton step moves. Right after an edit the imbalance is large and
@@ -177,143 +178,296 @@ void select_active(Context& c, double worst, const Eigen::Ref<const Eigen::Matri
   const double reach = c.settings.local_reach * decay;
   if (!(c.settings.local_fraction > 0) || !std::isfinite(reach)) {
     s.active_ = s.free_;
-    return;
+  } else {
+    const double threshold = std::max(c.settings.tolerance, c.settings.local_fraction * worst);
+    s.active_.assign(std::size_t(c.nv), 0);
+    s.seed_of_.assign(std::size_t(c.nv), -1);
+    s.reached_.clear();
+    for (std::int64_t v = 0; v < c.nv; ++v)
+      if (s.node_residual_[v] > threshold) {
+        s.active_[std::size_t(v)] = 1;
+        s.seed_of_[std::size_t(v)] = std::int32_t(v);
+        s.reached_.push_back(std::int32_t(v));
+      }
+    // Breadth first over the Hessian's graph, each node keeping the seed it was reached from.
+    const auto& start = c.model.block_start();
+    const auto& column = c.model.block_column();
+    for (std::size_t k = 0; k < s.reached_.size(); ++k) {
+      const std::int32_t v = s.reached_[k], seed = s.seed_of_[std::size_t(v)];
+      for (std::int32_t j = start[std::size_t(v)]; j < start[std::size_t(v) + 1]; ++j) {
+        const std::int32_t u = column[std::size_t(j)];
+        if (s.seed_of_[std::size_t(u)] >= 0 || !s.free_[std::size_t(u)]) continue;
+        if ((x.col(u) - x.col(seed)).norm() > reach) continue;
+        s.seed_of_[std::size_t(u)] = seed;
+        s.active_[std::size_t(u)] = 1;
+        s.reached_.push_back(u);
+      }
+    }
   }
-  const double threshold = std::max(c.settings.tolerance, c.settings.local_fraction * worst);
-  s.active_.assign(std::size_t(c.nv), 0);
-  s.seed_of_.assign(std::size_t(c.nv), -1);
-  s.reached_.clear();
+  s.active_list_.clear();
   for (std::int64_t v = 0; v < c.nv; ++v)
-    if (s.node_residual_[v] > threshold) {
-      s.active_[std::size_t(v)] = 1;
-      s.seed_of_[std::size_t(v)] = std::int32_t(v);
-      s.reached_.push_back(std::int32_t(v));
-    }
-  // Breadth first over the Hessian's graph, each node keeping the seed it was reached from.
-  const auto& start = c.model.block_start();
-  const auto& column = c.model.block_column();
-  for (std::size_t k = 0; k < s.reached_.size(); ++k) {
-    const std::int32_t v = s.reached_[k], seed = s.seed_of_[std::size_t(v)];
-    for (std::int32_t j = start[std::size_t(v)]; j < start[std::size_t(v) + 1]; ++j) {
-      const std::int32_t u = column[std::size_t(j)];
-      if (s.seed_of_[std::size_t(u)] >= 0 || !s.free_[std::size_t(u)]) continue;
-      if ((x.col(u) - x.col(seed)).norm() > reach) continue;
-      s.seed_of_[std::size_t(u)] = seed;
-      s.active_[std::size_t(u)] = 1;
-      s.reached_.push_back(u);
-    }
-  }
+    if (s.active_[std::size_t(v)]) s.active_list_.push_back(std::int32_t(v));
 }
 
-// Phase 5: assemble the Hessian approximation's 3 x 3 blocks of the active rows, each row
-// gathering from the elements it is a corner of (no two rows write one block, so the rows run
-// in parallel), then the nodal attachment and inertia terms on the diagonal; and invert the
-// diagonal blocks (block-Jacobi). Columns of inactive nodes are left out by hessian_apply.
+// What a step of the active nodes changes: the elements with an active corner, and every corner
+// of those (whose gradient changes with them).
+void mark_changed(Context& c) {
+  Solver::Scratch& s = c.s;
+  const auto& start = c.model.incidence_start();
+  const auto& inc = c.model.incidence();
+  const auto& faces = c.model.element_faces();
+  s.element_mark_.assign(std::size_t(c.ne), 0);
+  s.node_mark_.assign(std::size_t(c.nv), 0);
+  s.changed_.clear();
+  s.touched_.clear();
+  for (const std::int32_t v : s.active_list_)
+    for (std::int32_t k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
+      const std::int32_t e = inc[std::size_t(k)] / 3;
+      if (s.element_mark_[std::size_t(e)]) continue;
+      s.element_mark_[std::size_t(e)] = 1;
+      s.changed_.push_back(e);
+      for (const std::int32_t u : faces[std::size_t(e)])
+        if (!s.node_mark_[std::size_t(u)]) {
+          s.node_mark_[std::size_t(u)] = 1;
+          s.touched_.push_back(u);
+        }
+    }
+}
+
+// Phase 5: assemble the Hessian approximation's 3 x 3 blocks of the active rows from the
+// changed elements (those with an active corner), each element's six distinct blocks computed
+// once and added to the active rows they belong to; then the nodal attachment and inertia terms
+// on the diagonal, and the diagonal blocks' inverses (both preconditioners use them). Blocks of
+// inactive rows are neither written nor read.
 void assemble(Context& c) {
-  const auto& elements = c.model.elements();
+  Solver::Scratch& s = c.s;
   const auto& element_block = c.model.element_block();
   const auto& diagonal = c.model.diagonal_block();
   const auto& row_start = c.model.block_start();
-  const auto& start = c.model.incidence_start();
-  const auto& inc = c.model.incidence();
-  const double lambda = c.model.lambda(), mu = c.model.mu();
-  c.s.blocks_.resize(c.model.block_column().size());
-  c.s.block_inverse_.resize(static_cast<std::size_t>(c.nv));
-#pragma omp parallel for schedule(static) \
-    num_threads(c.threads) if (c.threads > 1 && c.ne > kParallelElements)
-  for (std::int64_t v = 0; v < c.nv; ++v) {
-    Solver::Scratch& s = c.s;
-    if (!s.active_[std::size_t(v)]) {
-      s.block_inverse_[std::size_t(v)].setZero();
-      continue;
-    }
+  s.blocks_.resize(c.model.block_column().size());
+  s.block_inverse_.resize(static_cast<std::size_t>(c.nv));
+  for (const std::int32_t v : s.active_list_)
     for (std::int32_t j = row_start[std::size_t(v)]; j < row_start[std::size_t(v) + 1]; ++j)
       s.blocks_[std::size_t(j)].setZero();
-    for (std::int32_t k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
-      const std::int32_t e = inc[std::size_t(k)] / 3, a = inc[std::size_t(k)] % 3;
-      Eigen::Matrix3d row[3];
-      detail::hessian_row(elements[std::size_t(e)], s.states_[std::size_t(e)], lambda, mu, a, row);
-      for (int b = 0; b < 3; ++b)
-        s.blocks_[std::size_t(element_block[std::size_t(9 * e + 3 * a + b)])] += row[b];
+  constexpr int kPair[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
+  for (const std::int32_t e : s.changed_) {
+    detail::ElementState& state = s.states_[std::size_t(e)];
+    detail::add_hessian_terms(state);
+    Eigen::Matrix3d upper[6];
+    detail::hessian_upper_blocks(c.model.elements()[std::size_t(e)], state, c.model.lambda(),
+                                 c.model.mu(), upper);
+    const mesh::Face& f = c.model.element_faces()[std::size_t(e)];
+    const auto block = [&](int a, int b) -> Eigen::Matrix3d& {
+      return s.blocks_[std::size_t(element_block[std::size_t(9 * e + 3 * a + b)])];
+    };
+    for (int k = 0; k < 6; ++k) {
+      const int a = kPair[k][0], b = kPair[k][1];
+      if (s.active_[std::size_t(f[a])]) block(a, b) += upper[k];
+      if (a != b && s.active_[std::size_t(f[b])]) block(b, a) += upper[k].transpose();
     }
+  }
+  for (const std::int32_t v : s.active_list_) {
     Eigen::Matrix3d& k = s.blocks_[std::size_t(diagonal[std::size_t(v)])];
     k += s.node_stiffness_[std::size_t(v)];
     if (c.dynamic) k.diagonal().array() += s.inertia_weight_[v];
-    const Eigen::Matrix3d regular =
-        k + (1e-12 * k.trace() + 1e-300) * Eigen::Matrix3d::Identity();  // a lone node
-    s.block_inverse_[std::size_t(v)] = regular.inverse();
+    k.diagonal().array() += 1e-12 * k.trace() + 1e-300;  // a lone node stays invertible
+    s.block_inverse_[std::size_t(v)] = k.inverse();
   }
 }
 
-// out = H d over the active nodes (d's other entries are read as zero, out's are zero).
+// out = H d over the active rows and columns (only active rows of out are written).
 void hessian_apply(Context& c, const Eigen::Matrix3Xd& d, Eigen::Matrix3Xd& out) {
   const auto& start = c.model.block_start();
   const auto& column = c.model.block_column();
-  out.resize(3, c.nv);
-#pragma omp parallel for schedule(static) \
-    num_threads(c.threads) if (c.threads > 1 && c.ne > kParallelElements)
-  for (std::int64_t v = 0; v < c.nv; ++v) {
+  const auto& list = c.s.active_list_;
+  const auto na = static_cast<std::int64_t>(list.size());
+#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
+  for (std::int64_t i = 0; i < na; ++i) {
+    const auto v = std::size_t(list[std::size_t(i)]);
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    if (!c.s.active_[std::size_t(v)]) {
-      out.col(v) = sum;
-      continue;
-    }
-    for (std::int32_t j = start[std::size_t(v)]; j < start[std::size_t(v) + 1]; ++j) {
+    for (std::int32_t j = start[v]; j < start[v + 1]; ++j) {
       const std::int32_t u = column[std::size_t(j)];
       if (c.s.active_[std::size_t(u)]) sum.noalias() += c.s.blocks_[std::size_t(j)] * d.col(u);
     }
-    out.col(v) = sum;
+    out.col(std::int64_t(v)) = sum;
   }
 }
 
-void precondition(const Context& c, const Eigen::Matrix3Xd& r, Eigen::Matrix3Xd& z) {
-  z.resize(3, c.nv);
-  for (std::int64_t v = 0; v < c.nv; ++v) z.col(v) = c.s.block_inverse_[std::size_t(v)] * r.col(v);
-}
-
-// Phase 6: H step = -g over the active nodes by preconditioned conjugate gradients; returns
-// the iterations.
-int conjugate_gradients(Context& c, const Eigen::Matrix3Xd& g, Eigen::Matrix3Xd& step) {
+// Phase 6: H step = -g over the active nodes by preconditioned conjugate gradients, on the
+// active columns only; returns the iterations.
+int jacobi_cg(Context& c) {
   Solver::Scratch& s = c.s;
-  step.setZero(3, c.nv);
-  s.r_.resize(3, c.nv);
-  for (std::int64_t v = 0; v < c.nv; ++v)
-    s.r_.col(v) = s.active_[std::size_t(v)] ? Eigen::Vector3d(-g.col(v)) : Eigen::Vector3d::Zero();
-  precondition(c, s.r_, s.z_);
-  s.p_ = s.z_;
-  double rz = (s.r_.array() * s.z_.array()).sum();
-  const double stop = c.settings.cg_relative_tolerance * s.r_.norm();
+  const auto& list = s.active_list_;
+  double rz = 0, rr = 0;
+  for (const std::int32_t v : list) {
+    s.step_.col(v).setZero();
+    s.r_.col(v) = -s.gradient_.col(v);
+    s.z_.col(v) = s.block_inverse_[std::size_t(v)] * s.r_.col(v);
+    s.p_.col(v) = s.z_.col(v);
+    rz += s.r_.col(v).dot(s.z_.col(v));
+    rr += s.r_.col(v).squaredNorm();
+  }
+  const double stop = c.settings.cg_relative_tolerance * std::sqrt(rr);
   int it = 0;
-  while (it < c.settings.max_cg_iterations && s.r_.norm() > stop) {
+  while (it < c.settings.max_cg_iterations && std::sqrt(rr) > stop) {
     hessian_apply(c, s.p_, s.q_);
-    const double pq = (s.p_.array() * s.q_.array()).sum();
+    double pq = 0;
+    for (const std::int32_t v : list) pq += s.p_.col(v).dot(s.q_.col(v));
     if (!(pq > 0)) break;  // no curvature left along p (cannot happen with a PSD H unless p = 0)
     const double alpha = rz / pq;
-    step += alpha * s.p_;
-    s.r_ -= alpha * s.q_;
-    precondition(c, s.r_, s.z_);
-    const double rz_next = (s.r_.array() * s.z_.array()).sum();
-    s.p_ = s.z_ + (rz_next / rz) * s.p_;
+    double rz_next = 0;
+    rr = 0;
+    for (const std::int32_t v : list) {
+      s.step_.col(v) += alpha * s.p_.col(v);
+      s.r_.col(v) -= alpha * s.q_.col(v);
+      s.z_.col(v) = s.block_inverse_[std::size_t(v)] * s.r_.col(v);
+      rz_next += s.r_.col(v).dot(s.z_.col(v));
+      rr += s.r_.col(v).squaredNorm();
+    }
+    const double beta = rz_next / rz;
+    for (const std::int32_t v : list) s.p_.col(v) = s.z_.col(v) + beta * s.p_.col(v);
     rz = rz_next;
     ++it;
   }
   return it;
 }
 
-// Phase 7: backtracking (Armijo) line search on Phi; returns false if no decrease was found.
-bool line_search(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x, const Eigen::Matrix3Xd& g,
-                 const Eigen::Matrix3Xd& step, double phi) {
-  const double slope = (g.array() * step.array()).sum();
+// With H = l + l^T - D (l = D + L, L the strictly lower blocks in vertex order, over the active
+// rows and columns): out = l^-1 rhs (forward) or l^-T rhs (backward) by block substitution.
+void lower_solve(Context& c, const Eigen::Matrix3Xd& rhs, Eigen::Matrix3Xd& out, bool forward) {
+  Solver::Scratch& s = c.s;
+  const auto& start = c.model.block_start();
+  const auto& column = c.model.block_column();
+  const auto& diagonal = c.model.diagonal_block();
+  const auto n = static_cast<std::int64_t>(s.active_list_.size());
+  for (std::int64_t i = 0; i < n; ++i) {
+    const auto v = std::size_t(s.active_list_[std::size_t(forward ? i : n - 1 - i)]);
+    Eigen::Vector3d sum = rhs.col(std::int64_t(v));
+    const std::int32_t first = forward ? start[v] : diagonal[v] + 1;
+    const std::int32_t last = forward ? diagonal[v] : start[v + 1];
+    for (std::int32_t j = first; j < last; ++j) {
+      const std::int32_t u = column[std::size_t(j)];
+      if (s.active_[std::size_t(u)]) sum.noalias() -= s.blocks_[std::size_t(j)] * out.col(u);
+    }
+    out.col(std::int64_t(v)) = s.block_inverse_[v] * sum;
+  }
+}
+
+// Symmetric Gauss-Seidel preconditioned CG by Eisenstat's trick: CG on the SPD system
+// l^-1 H l^-T y = l^-1 b (b = -g, step = l^-T y) with the preconditioner D, where
+//   l^-1 H l^-T p = t + l^-1 (p - D t),  t = l^-T p,
+// costs one forward and one backward sweep (together one multiplication by H). The stopping
+// test is on the transformed residual, relative to its start.
+int gauss_seidel_cg(Context& c) {
+  Solver::Scratch& s = c.s;
+  const auto& list = s.active_list_;
+  const auto& diagonal = c.model.diagonal_block();
+  const auto d = [&](std::int32_t v) -> const Eigen::Matrix3d& {
+    return s.blocks_[std::size_t(diagonal[std::size_t(v)])];
+  };
+  for (const std::int32_t v : list) s.q_.col(v) = -s.gradient_.col(v);
+  lower_solve(c, s.q_, s.r_, true);  // r = l^-1 b
+  double rz = 0;
+  for (const std::int32_t v : list) {
+    s.step_.col(v).setZero();  // y
+    s.z_.col(v) = d(v) * s.r_.col(v);
+    s.p_.col(v) = s.z_.col(v);
+    rz += s.r_.col(v).dot(s.z_.col(v));
+  }
+  const double stop = c.settings.cg_relative_tolerance * std::sqrt(rz);
+  int it = 0;
+  while (it < c.settings.max_cg_iterations && std::sqrt(rz) > stop) {
+    lower_solve(c, s.p_, s.trial_direction_, false);  // t = l^-T p
+    for (const std::int32_t v : list) s.q_.col(v) = s.p_.col(v) - d(v) * s.trial_direction_.col(v);
+    lower_solve(c, s.q_, s.q_, true);  // in place: row v reads only rows before it
+    double pq = 0;
+    for (const std::int32_t v : list) {
+      s.q_.col(v) += s.trial_direction_.col(v);
+      pq += s.p_.col(v).dot(s.q_.col(v));
+    }
+    if (!(pq > 0)) break;
+    const double alpha = rz / pq;
+    double rz_next = 0;
+    for (const std::int32_t v : list) {
+      s.step_.col(v) += alpha * s.p_.col(v);
+      s.r_.col(v) -= alpha * s.q_.col(v);
+      s.z_.col(v) = d(v) * s.r_.col(v);
+      rz_next += s.r_.col(v).dot(s.z_.col(v));
+    }
+    const double beta = rz_next / rz;
+    for (const std::int32_t v : list) s.p_.col(v) = s.z_.col(v) + beta * s.p_.col(v);
+    rz = rz_next;
+    ++it;
+  }
+  for (const std::int32_t v : list) s.q_.col(v) = s.step_.col(v);
+  lower_solve(c, s.q_, s.step_, false);  // step = l^-T y
+  return it;
+}
+
+int conjugate_gradients(Context& c) {
+  Solver::Scratch& s = c.s;
+  for (auto* m : {&s.step_, &s.r_, &s.z_, &s.p_, &s.q_, &s.trial_direction_}) m->resize(3, c.nv);
+  return c.settings.preconditioner == Preconditioner::block_jacobi ? jacobi_cg(c)
+                                                                   : gauss_seidel_cg(c);
+}
+
+// Phi(x + alpha step) - Phi(x): only the changed elements and the active nodes' own terms
+// differ, so the difference is summed over them (cheap, and free of the cancellation that
+// comparing two totals of the whole mesh suffers near the solution). The trial elements'
+// states are kept for the accepted step.
+double potential_change(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x, double alpha) {
+  Solver::Scratch& s = c.s;
+  for (const std::int32_t v : s.active_list_) s.trial_.col(v) = x.col(v) + alpha * s.step_.col(v);
+  const auto nc = static_cast<std::int64_t>(s.changed_.size());
+  s.trial_states_.resize(std::size_t(nc));
+  double change = 0;
+#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel()) \
+    reduction(+ : change)
+  for (std::int64_t k = 0; k < nc; ++k) {
+    const std::int32_t e = s.changed_[std::size_t(k)];
+    s.trial_states_[std::size_t(k)] = forces_at(c, e, s.trial_);
+    change += c.model.elements()[std::size_t(e)].area_thickness *
+              (s.trial_states_[std::size_t(k)].psi - s.states_[std::size_t(e)].psi);
+  }
+  for (const std::int32_t v : s.active_list_)
+    change += nodal_potential(c, v, s.trial_.col(v)) - nodal_potential(c, v, x.col(v));
+  return change;
+}
+
+// The step to trial_ is taken: x, the changed elements' states, and the gradient updated by
+// the change of each changed element's forces and of the active nodes' own terms.
+void accept_step(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
+  Solver::Scratch& s = c.s;
+  for (std::size_t k = 0; k < s.changed_.size(); ++k) {
+    const std::int32_t e = s.changed_[k];
+    scatter_element(c, e, s.trial_states_[k].p - s.states_[std::size_t(e)].p);
+    s.states_[std::size_t(e)] = s.trial_states_[k];
+  }
+  for (const std::int32_t v : s.active_list_) {
+    const Eigen::Vector3d dx = s.trial_.col(v) - x.col(v);
+    s.gradient_.col(v) += s.node_stiffness_[std::size_t(v)] * dx;
+    if (c.dynamic) s.gradient_.col(v) += s.inertia_weight_[v] * dx;
+    x.col(v) = s.trial_.col(v);
+  }
+  for (const std::int32_t v : s.touched_) node_residual(c, v);
+}
+
+// Phase 7: backtracking (Armijo) line search on Phi; on success x, the changed elements'
+// states and the touched nodes' gradients are those of the new positions. Returns false if no
+// decrease was found (x and the states are left as they were).
+bool line_search(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
+  Solver::Scratch& s = c.s;
+  double slope = 0;
+  for (const std::int32_t v : s.active_list_) slope += s.gradient_.col(v).dot(s.step_.col(v));
   if (!(slope < 0)) return false;
   double alpha = 1;
   for (int k = 0; k < 30; ++k, alpha *= 0.5) {
-    c.s.trial_ = x + alpha * step;
-    const double trial = potential(c, c.s.trial_);
-    if (std::isfinite(trial) && trial <= phi + 1e-4 * alpha * slope) {
-      x = c.s.trial_;
-      return true;
-    }
+    const double change = potential_change(c, x, alpha);
+    if (!(std::isfinite(change) && change <= 1e-4 * alpha * slope)) continue;
+    accept_step(c, x);
+    return true;
   }
+  for (const std::int32_t v : s.active_list_) s.trial_.col(v) = x.col(v);
   return false;
 }
 
@@ -345,11 +499,12 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
   prepare_nodes(c, x);
   s.free_.resize(std::size_t(nv));
   for (Eigen::Index v = 0; v < nv; ++v) s.free_[std::size_t(v)] = !c.fixed(v);
+  s.trial_ = x;
+  evaluate_elements(c, x);
+  gradient_all(c, x);
   SolveReport report;
   for (;; ++report.newton_iterations) {
-    evaluate_elements(c, x);
-    gather_gradient(c, x, s.gradient_);
-    report.residual = residual(c, s.gradient_);
+    report.residual = s.node_residual_.size() ? s.node_residual_.maxCoeff() : 0.0;
     if (report.newton_iterations == 0) report.initial_residual = report.residual;
     if (report.residual <= settings.tolerance) {
       report.converged = true;
@@ -357,9 +512,10 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
     }
     if (report.newton_iterations == settings.max_newton_iterations) break;
     select_active(c, report.residual, x);
+    mark_changed(c);
     assemble(c);
-    report.cg_iterations += conjugate_gradients(c, s.gradient_, s.step_);
-    if (!line_search(c, x, s.gradient_, s.step_, potential(c, x))) break;
+    report.cg_iterations += conjugate_gradients(c);
+    if (!line_search(c, x)) break;
   }
   return report;
 }

@@ -77,21 +77,38 @@ inline Eigen::Matrix2d positive_part(const Eigen::Matrix2d& s) {
 
 /// Per-iteration data of one element at the current positions.
 struct ElementState {
-  Mat32 f;                // deformation gradient
-  Eigen::Matrix2d s_pos;  // S+ (for the Hessian)
-  Mat32 p;                // first Piola-Kirchhoff stress F S (for the gradient)
-  Eigen::Matrix3d ff;     // F F^T (shared by the element's nine Hessian blocks)
+  Mat32 f;                 // deformation gradient
+  Mat32 p;                 // first Piola-Kirchhoff stress F S (for the gradient)
+  Eigen::Matrix2d stress;  // second Piola-Kirchhoff stress S
+  double psi = 0;          // energy density, J/m^2
+  Eigen::Matrix2d s_pos;   // S+ (for the Hessian; add_hessian_terms)
+  Eigen::Matrix3d ff;      // F F^T (shared by the element's nine Hessian blocks; ditto)
 };
+
+/// F, S, P and psi: what the energy and the gradient need.
+inline ElementState element_forces(const ElementRest& e, const Eigen::Vector3d& x0,
+                                   const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
+                                   double lambda, double mu) {
+  ElementState s;
+  s.f = deformation_gradient(e, x0, x1, x2);
+  const Eigen::Matrix2d strain = green_strain(s.f);
+  s.stress = pk2_stress(e, strain, lambda, mu);
+  s.psi = energy_density(e, strain, lambda, mu);
+  s.p = s.f * s.stress;
+  return s;
+}
+
+/// S+ and F F^T from F and S: what the Hessian blocks need besides them.
+inline void add_hessian_terms(ElementState& s) {
+  s.s_pos = positive_part(s.stress);
+  s.ff = s.f * s.f.transpose();
+}
 
 inline ElementState element_state(const ElementRest& e, const Eigen::Vector3d& x0,
                                   const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
                                   double lambda, double mu) {
-  ElementState s;
-  s.f = deformation_gradient(e, x0, x1, x2);
-  const Eigen::Matrix2d stress = pk2_stress(e, green_strain(s.f), lambda, mu);
-  s.p = s.f * stress;
-  s.s_pos = positive_part(stress);
-  s.ff = s.f * s.f.transpose();
+  ElementState s = element_forces(e, x0, x1, x2, lambda, mu);
+  add_hessian_terms(s);
   return s;
 }
 
@@ -123,19 +140,25 @@ inline Eigen::Matrix3d hessian_block(const ElementRest& e, const ElementState& s
           mu * fb * fa.transpose() + lambda * fa * fb.transpose());
 }
 
-/// Row a of the element's blocks, K_a0, K_a1, K_a2 (the formula of hessian_block, with the
-/// terms of corner a computed once): what a vertex gathers from each element it is corner a of.
-inline void hessian_row(const ElementRest& e, const ElementState& s, double lambda, double mu,
-                        int a, Eigen::Matrix3d* out) {
-  const Eigen::Vector2d ba = beta_of(e, a);
-  const Eigen::Vector3d fa = s.f * ba;
-  const Eigen::Vector2d sba = s.s_pos * ba;
-  for (int b = 0; b < 3; ++b) {
-    const Eigen::Vector2d bb = beta_of(e, b);
-    const Eigen::Vector3d fb = s.f * bb;
-    out[b].noalias() =
-        e.area_thickness * ((sba.dot(bb)) * Eigen::Matrix3d::Identity() + mu * ba.dot(bb) * s.ff +
-                            mu * fb * fa.transpose() + lambda * fa * fb.transpose());
+/// The element's six distinct blocks K_ab, a <= b, in the order (0,0), (0,1), (0,2), (1,1),
+/// (1,2), (2,2) (the formula of hessian_block, with each corner's terms computed once); the
+/// others are K_ba = K_ab^T, since S+ and F F^T are symmetric.
+inline void hessian_upper_blocks(const ElementRest& e, const ElementState& s, double lambda,
+                                 double mu, Eigen::Matrix3d* out) {
+  Eigen::Vector2d beta[3];
+  Eigen::Vector3d f[3];
+  for (int a = 0; a < 3; ++a) {
+    beta[a] = beta_of(e, a);
+    f[a] = s.f * beta[a];
+  }
+  int k = 0;
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::Vector2d sba = s.s_pos * beta[a];
+    for (int b = a; b < 3; ++b, ++k)
+      out[k].noalias() =
+          e.area_thickness *
+          ((sba.dot(beta[b])) * Eigen::Matrix3d::Identity() + mu * beta[a].dot(beta[b]) * s.ff +
+           mu * f[b] * f[a].transpose() + lambda * f[a] * f[b].transpose());
   }
 }
 
