@@ -23,6 +23,23 @@ double segment_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
   return (p - (a + t * ab)).norm();
 }
 
+// Whether segment (a, b) crosses triangle (p, q, r) (Möller–Trumbore, closed triangle).
+bool crosses(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& p,
+             const Eigen::Vector3d& q, const Eigen::Vector3d& r) {
+  const Eigen::Vector3d d = b - a, e1 = q - p, e2 = r - p;
+  const Eigen::Vector3d h = d.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) < 1e-300) return false;
+  const Eigen::Vector3d s = a - p;
+  const double u = s.dot(h) / det;
+  if (u < 0 || u > 1) return false;
+  const Eigen::Vector3d k = s.cross(e1);
+  const double v = d.dot(k) / det;
+  if (v < 0 || u + v > 1) return false;
+  const double t = e2.dot(k) / det;
+  return t >= 0 && t <= 1;
+}
+
 }  // namespace
 
 RigidScalpel::RigidScalpel(SkinnedSoftBody& body, const btRigidBody& blade,
@@ -50,13 +67,16 @@ RigidScalpel::RigidScalpel(SkinnedSoftBody& body, const btRigidBody& blade,
                            const btVector3& a_local, const btVector3& b_local)
     : RigidScalpel(body, blade, a_local, b_local, Options{}) {}
 
-// h: before the tear starts, the mean edge length of the mesh; after, of the faces at the tip.
+// h: before the tear starts, the mean edge length of the mesh; after, of the faces at the tip,
+// which are also kept as the tip's fan.
 void RigidScalpel::measure_edges() {
   const auto& faces = body_.mesh().faces;
   double sum = 0;
   std::int64_t count = 0;
+  fan_.clear();
   for (const auto& f : faces) {
     if (tip_ >= 0 && f[0] != tip_ && f[1] != tip_ && f[2] != tip_) continue;
+    if (tip_ >= 0) fan_.push_back(f);
     for (int k = 0; k < 3; ++k)
       sum +=
           (body_.position(f[std::size_t(k)]) - body_.position(f[std::size_t((k + 1) % 3)])).norm();
@@ -65,8 +85,14 @@ void RigidScalpel::measure_edges() {
   if (count > 0) edge_length_ = sum / double(count);
 }
 
-double RigidScalpel::tip_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
-  return segment_distance(body_.position(tip_), a, b);
+bool RigidScalpel::ready(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+  if (tip_ < 0) return true;
+  if (segment_distance(body_.position(tip_), a, b) < options_.min_advance * edge_length_)
+    return false;
+  for (const auto& f : fan_)
+    if (crosses(a, b, body_.position(f[0]), body_.position(f[1]), body_.position(f[2])))
+      return false;
+  return true;
 }
 
 void RigidScalpel::submit(const mesh::ScalpelSample& sample, Update& update) {
@@ -97,7 +123,7 @@ RigidScalpel::Update RigidScalpel::update(double time) {
       const double s = double(k) / n;
       const mesh::ScalpelSample sample{time_ + s * (time - time_), a_ + s * (a1 - a_),
                                        b_ + s * (b1 - b_)};
-      if (tip_ < 0 || tip_distance(sample.a, sample.b) >= options_.min_advance * edge_length_)
+      if (ready(sample.a, sample.b))
         submit(sample, update);
       else
         ++update.held;

@@ -17,8 +17,8 @@
 // region the blade swept). Measured with the blade moving 2.5 mm per frame over 3 cm faces
 // (plugin_rigid_scalpel_test), one sample per frame vs this scalpel vs a stroke of one sample
 // per centimetre given to tear_advance:
-//   flat sheet:  60 of 97 samples extended, 77 path points | 23 of 24, 40 points | 42 points;
-//   curved arm:  58 of 97, 73 path points                  | 26 of 29, 41 points | 39 points;
+//   flat sheet:  60 of 97 samples extended, 77 path points | 16 of 17, 33 points | 42 points;
+//   curved arm:  58 of 97, 73 path points                  | 14 of 15, 29 points | 39 points;
 // with the same tip and the same length (within one local edge) in all three.
 //
 // What update() does with the blade's motion since the previous call (taken as linear: the
@@ -26,8 +26,10 @@
 //   - sub-samples it so that no sample moves the blade more than max_advance × h from the
 //     previous sample, h being the mean length of the edges at the tear's tip (before the
 //     tear starts, of the mesh), so every face the blade sweeps is reached;
-//   - submits a sample only once the blade is at least min_advance × h from the tip
-//     (accumulating the motion until then), so the new tip lands outside the old tip's fan.
+//   - submits a sample only once the blade is at least min_advance × h from the tip and no
+//     longer crosses a face around the tip (accumulating the motion until then), so the new
+//     tip lands outside the old tip's fan of thin faces. The tip thus lags the blade by at
+//     most about one face; a blade that stops inside the tip's faces leaves the tear there.
 // Until the tear has started, every sub-sample is submitted (the first that meets the
 // surface starts it). The blade's end points are in the rigid body's local frame; samples
 // are in world space (as SkinnedSoftBody's tear_advance takes them).
@@ -40,6 +42,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <vector>
 
 #include "conform/bullet/skinned_soft_body.hpp"
 #include "conform/mesh/tear.hpp"
@@ -83,7 +86,7 @@ class RigidScalpel {
 
  private:
   void submit(const mesh::ScalpelSample& sample, Update& update);
-  double tip_distance(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
+  bool ready(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const;
   void measure_edges();
 
   SkinnedSoftBody& body_;
@@ -95,6 +98,7 @@ class RigidScalpel {
   double time_ = 0;
   double edge_length_ = 0;
   std::int32_t tip_ = -1;
+  std::vector<mesh::Face> fan_;  // the faces around the tip
   Update totals_;
 };
 
