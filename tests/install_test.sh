@@ -48,5 +48,9 @@ readelf -d "$work/build/importer" | grep -q 'assimp' || fail "the importer does 
 "$work/build/importer" arm
 model=/usr/share/assimp/models/OBJ/box.obj
 if [[ -r "$model" ]]; then "$work/build/importer" "$model"; fi
+# The whole application: a rigged model playing (a real one when assimp-testmodels is there).
+character=/usr/share/assimp/models/X/anim_test.x
+[[ -r "$character" ]] || character=arm
+"$work/build/application" "$character"
 echo "install_test: find_package(Conform) from $work/prefix works (CONFORM_DOUBLE=$double);" \
   "the Bullet consumer links no assimp and compiles with no Conform flags"
