@@ -217,6 +217,9 @@ void register_cut(CLI::App& app, Context& context) {
   auto common = std::make_shared<Common>();
   auto plane = std::make_shared<std::vector<double>>();
   auto cap = std::make_shared<bool>(false);
+  auto sphere = std::make_shared<std::vector<double>>();
+  auto seed = std::make_shared<std::vector<double>>();
+  auto touching = std::make_shared<bool>(false);
   auto* cmd =
       app.add_subcommand("cut", "Cut a model by a plane (Algorithm 1) and write the pieces");
   add_common(cmd, *common);
@@ -224,7 +227,17 @@ void register_cut(CLI::App& app, Context& context) {
       ->expected(4)
       ->required();
   cmd->add_flag("--cap", *cap, "close every cut loop with a triangulated cap");
-  cmd->callback([&context, common, plane, cap]() {
+  auto* sphere_opt =
+      cmd->add_option("--region-sphere", *sphere,
+                      "cut only the sections of the plane inside this sphere: X Y Z R")
+          ->expected(4);
+  cmd->add_option("--region-seed", *seed, "cut only the section nearest this point: X Y Z")
+      ->expected(3)
+      ->excludes(sphere_opt);
+  cmd->add_flag("--touching", *touching,
+                "with --region-sphere: the sections that meet the sphere (default: inside it)")
+      ->needs(sphere_opt);
+  cmd->callback([&context, common, plane, cap, sphere, seed, touching]() {
     run(context, "cut", [&] {
       nlohmann::json summary;
       summary["command"] = "cut";
@@ -234,15 +247,26 @@ void register_cut(CLI::App& app, Context& context) {
       mesh::Adjacency adjacency(m);
       const double t_adj = ms_since(t0);
       const auto t1 = Clock::now();
-      const mesh::CutOutcome out = mesh::cut(
-          m, adjacency, cga::Plane<double>::from_normal_distance({p[0], p[1], p[2]}, p[3]),
-          {.cap = *cap});
+      mesh::CutOptions options{.cap = *cap};
+      const auto& sp = *sphere;
+      if (!sp.empty())
+        options.region = mesh::CutRegion::sphere(
+            {sp[0], sp[1], sp[2]}, sp[3],
+            *touching ? mesh::CutRegion::Keep::touching : mesh::CutRegion::Keep::inside);
+      if (!seed->empty())
+        options.region = mesh::CutRegion::seed({(*seed)[0], (*seed)[1], (*seed)[2]});
+      const mesh::CutOutcome out =
+          mesh::cut(m, adjacency,
+                    cga::Plane<double>::from_normal_distance({p[0], p[1], p[2]}, p[3]), options);
       summary["timing_ms"]["adjacency"] = t_adj;
       summary["timing_ms"]["operation"] = ms_since(t1);
       summary["status"] = out.result.status == mesh::CutStatus::Cut ? "cut" : "missed";
       summary["crossed_edges"] = out.result.crossed_edges;
       summary["snapped_vertices"] = out.result.snapped_vertices;
       summary["new_vertices"] = out.result.change.new_vertices.size();
+      if (options.region.shape != mesh::CutRegion::Shape::everywhere)
+        summary["region"] = {{"sections", out.result.sections},
+                             {"kept_sections", out.result.kept_sections}};
       if (*cap)
         summary["cap"] = {{"loops", out.result.loops},
                           {"capped", out.result.capped_loops},

@@ -3,7 +3,8 @@
 # find_package(Conform) and runs it. Checks what an application gets from the package: the
 # Bullet consumer (conform::core, conform::bullet) compiles without -fopenmp or any Conform
 # definition and links no assimp; the importer (conform::io) links assimp and reads a model;
-# no internal or detail/ header (other than cga's, which multivector.hpp needs) is installed.
+# no internal or detail/ header (other than cga's, which multivector.hpp needs) is installed;
+# the application (tests/consumer/application.cpp) runs, also built with ASan and UBSan.
 # Arguments: <conform binary> <source dir> <build dir>.
 set -euo pipefail
 source_dir="$2"
@@ -48,5 +49,27 @@ readelf -d "$work/build/importer" | grep -q 'assimp' || fail "the importer does 
 "$work/build/importer" arm
 model=/usr/share/assimp/models/OBJ/box.obj
 if [[ -r "$model" ]]; then "$work/build/importer" "$model"; fi
+# The whole application: a rigged model playing (a real one when assimp-testmodels is there).
+character=/usr/share/assimp/models/X/anim_test.x
+[[ -r "$character" ]] || character=arm
+"$work/build/application" "$character"
+
+# The same application built with ASan and UBSan against the (unsanitized) package: no report.
+# Skipped, with a warning, where a sanitized program cannot start (address-space limits).
+echo 'int main() { return 0; }' >"$work/probe.cpp"
+if c++ -fsanitize=address,undefined "$work/probe.cpp" -o "$work/probe" >/dev/null 2>&1 &&
+  "$work/probe" >/dev/null 2>&1; then
+  cmake -S "$source_dir/tests/consumer" -B "$work/build-sanitize" -DCMAKE_PREFIX_PATH="$work/prefix" \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    "-DCMAKE_CXX_FLAGS=-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" \
+    >/dev/null
+  cmake --build "$work/build-sanitize" --target application >/dev/null
+  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    "$work/build-sanitize/application" "$character" >"$work/sanitized.log" 2>&1 ||
+    { cat "$work/sanitized.log"; fail "the sanitized application failed or reported"; }
+  echo "install_test: the application under ASan+UBSan: $(tail -1 "$work/sanitized.log")"
+else
+  echo "install_test: WARNING: an ASan+UBSan program cannot start here; the sanitized run is skipped" >&2
+fi
 echo "install_test: find_package(Conform) from $work/prefix works (CONFORM_DOUBLE=$double);" \
   "the Bullet consumer links no assimp and compiles with no Conform flags"

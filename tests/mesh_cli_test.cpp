@@ -76,6 +76,32 @@ TEST_F(MeshCli, CutWithCapWritesClosedPieces) {
   fs::remove_all(d);
 }
 
+// --region-seed / --region-sphere (cut_region.hpp): huesitos.fbx's trunk and side branch are
+// both crossed by this plane; limited to the branch, one loop is cut and two pieces written.
+TEST_F(MeshCli, RegionalCutCutsOneSection) {
+  const std::string model = std::string(CONFORM_ASSIMP_MODELS) + "/FBX/huesitos.fbx";
+  if (!fs::exists(model)) GTEST_SKIP() << "assimp-testmodels not installed";
+  const fs::path d = fresh_dir("region");
+  const std::string plane = " --plane 0 1 -1 500 --cap --out " + d.string();
+  ASSERT_EQ(run("cut " + model + plane), 0);
+  EXPECT_EQ(summary(d)["output"]["pieces"], 3);
+  fs::remove_all(d);
+  ASSERT_EQ(run("cut " + model + plane + " --region-seed 400 300 -300"), 0);
+  const auto s = summary(d);
+  EXPECT_EQ(s["region"]["sections"], 2);
+  EXPECT_EQ(s["region"]["kept_sections"], 1);
+  EXPECT_EQ(s["output"]["pieces"], 2);
+  EXPECT_EQ(s["output"]["closed"], true);
+  fs::remove_all(d);
+  // A sphere that holds no whole section: a documented no-op (exit 0, status missed).
+  ASSERT_EQ(run("cut " + model + plane + " --region-sphere 400 300 -300 1"), 0);
+  EXPECT_EQ(summary(d)["status"], "missed");
+  fs::remove_all(d);
+  EXPECT_NE(run("cut " + model + plane + " --region-sphere 0 0 0 -1"), 0);        // bad radius
+  EXPECT_NE(run("cut arm --plane 0 0 1 0.3 --touching --out " + d.string()), 0);  // no sphere
+  fs::remove_all(d);
+}
+
 TEST_F(MeshCli, DrillAndTear) {
   const fs::path d = fresh_dir("drill");
   ASSERT_EQ(run("drill arm --tip 0 -0.2 0.4 --base 0 0.2 0.4 --radius 0.01 --format obj --out " +

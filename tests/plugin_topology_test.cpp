@@ -214,6 +214,44 @@ TEST(PluginTopology, CutSplitsTheArmIntoTwoLiveBodies) {
   EXPECT_GT(forearm_kinematic, 100);
 }
 
+TEST(PluginTopology, RegionalCutSeversTheUpperArmOnlyKeepingMassAndMomentum) {
+  // The arm bending its elbow past a right angle, so that a plane across the upper arm also
+  // crosses the forearm. A sphere at the upper arm (placed from the joints' transforms) limits
+  // the cut to that loop: two pieces, not three, and no new node outside the sphere.
+  SoftWorld w;
+  bullet::Plugin plugin{w.world};
+  const mesh::Arm arm = mesh::make_arm(1);
+  auto& body = plugin.add_skinned_body(
+      arm.mesh, arm.skeleton, {.model = bullet::MaterialModel::bullet_links, .pretension = 0.1});
+  skin::PoseTrack track;
+  track.set_key(0, skin::Pose::rest(arm.skeleton));
+  track.set_key(0.5, conform::test::bent_arm_pose(arm.skeleton, 0, 2.6));
+  body.set_keyframes(track);
+  w.step(24);  // still moving: every node has a velocity
+  const auto joints = body.joint_transforms();
+  const Eigen::Vector3d shoulder = joints[0].apply(cga::Vec3<double>::Zero()),
+                        elbow = joints[1].apply(cga::Vec3<double>::Zero());
+  const Eigen::Vector3d p = shoulder + (elbow - shoulder) * (2.0 / 3);
+  const auto plane = cga::Plane<double>::from_normal_point(elbow - shoulder, p);
+  body.sync_mesh();
+  ASSERT_EQ(mesh::compute_cut(body.mesh(), plane, {.cap = true}).loops, 2);  // unbounded
+  mesh::CutOptions options{.cap = true};
+  options.region = mesh::CutRegion::sphere(p, 0.09);
+  const Snapshot before = snapshot(body);
+  const auto result = body.cut(plane, options);
+  ASSERT_EQ(result.status, mesh::CutStatus::Cut) << result.message;
+  EXPECT_EQ(result.sections, 2);  // the unbounded plane would cut the forearm too
+  EXPECT_EQ(result.kept_sections, 1);
+  EXPECT_EQ(result.capped_loops, 1) << result.message;
+  expect_conserved(body, before, {result.change}, "regional cut");
+  expect_mirrors_mesh(body, "regional cut");
+  EXPECT_EQ(body.piece_count(), 2);
+  for (std::int32_t v = result.change.base_vertex_count; v < body.vertex_count(); ++v)
+    ASSERT_LE((body.position(v) - p).norm(), 0.09) << "vertex " << v;
+  w.step(10);  // both pieces simulate on
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v) ASSERT_TRUE(body.position(v).allFinite());
+}
+
 TEST(PluginTopology, TearStepsEditInPlace) {
   LiveArm a;
   auto& body = *a.body;

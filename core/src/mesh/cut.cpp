@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 
@@ -41,7 +42,7 @@ struct Scratch {
   std::vector<std::int8_t> side;
   std::vector<std::uint8_t> code;
   std::vector<std::int32_t> work, crossed, evaluate, again, snapped_now, parent, xcopy,
-      plane_vertices, copy_plus, copy_minus, next, starts, ids, loop;
+      plane_vertices, copy_plus, copy_minus, next, starts, ids, loop, section_parent, section_of;
   EdgeMap crossing;
   std::vector<Eigen::Vector3d> xpos;
   std::vector<Pending> pending;
@@ -115,6 +116,10 @@ class CutComputation {
     find_work_faces();
     snap();
     if (outside_work_) add_faces_around_far_snaps();
+    if (options_.region.shape != CutRegion::Shape::everywhere && !select_sections()) {
+      result_.message = "the plane crosses the mesh only in sections outside the region";
+      return std::move(result_);
+    }
     if (!split_crossed_faces()) {
       result_.change.new_vertices.clear();
       result_.crossed_edges = 0;
@@ -138,6 +143,8 @@ class CutComputation {
           "0.5)");
     if (mesh_.current.cols() != nv0_)
       throw std::invalid_argument("cut: the current positions must be finite, one per vertex");
+    if (const std::string problem = options_.region.validate(); !problem.empty())
+      throw std::invalid_argument(problem);
   }
 
   // Step 1, in one pass over the positions: finite, their bounding box (the tolerance's
@@ -386,6 +393,80 @@ class CutComputation {
     }
     std::inplace_merge(work.begin(), work.begin() + static_cast<std::ptrdiff_t>(before),
                        work.end());
+  }
+
+  // A work face crossed by the plane or touching it (a section's face).
+  bool in_section(const Face& f) const {
+    const std::int8_t* const sd = sc_.side.data();
+    const std::int8_t s[3] = {sd[f[0]], sd[f[1]], sd[f[2]]};
+    return s[0] == 0 || s[1] == 0 || s[2] == 0 || is_crossed(s);
+  }
+
+  // The region's whole sections (cut_region.hpp), after step 2 so that snapped vertices count
+  // as on the plane: the section faces grouped by shared vertices, each group's points (its
+  // crossing points and vertices on the plane) measured against the region, and the work list
+  // cut down to the kept groups' faces. Sharing any vertex is a coarser grouping than sharing a
+  // crossed edge or a fan vertex, so no fan or crossing vertex is ever split between a kept and
+  // a dropped face. False when no kept section crosses the plane.
+  bool select_sections() {
+    const CutRegion& region = options_.region;
+    const std::int8_t* const sd = sc_.side.data();
+    std::vector<std::int32_t>& parent = sc_.section_parent;
+    parent.resize(static_cast<std::size_t>(nv0_));
+    std::iota(parent.begin(), parent.end(), 0);
+    for (const std::int32_t fi : sc_.work) {
+      const Face& f = mesh_.faces[static_cast<std::size_t>(fi)];
+      if (!in_section(f)) continue;
+      detail::unite(parent.data(), f[0], f[1]);
+      detail::unite(parent.data(), f[0], f[2]);
+    }
+    struct Section {
+      std::int32_t points = 0, inside = 0;
+      bool crossed = false;
+      double nearest = std::numeric_limits<double>::infinity();  // squared, to region.center
+    };
+    std::vector<Section> sections;
+    std::vector<std::int32_t>& section_of = sc_.section_of;  // by root vertex
+    section_of.assign(static_cast<std::size_t>(nv0_), -1);
+    auto measure = [&](Section& s, const Eigen::Vector3d& x) {
+      ++s.points;
+      s.inside += region.contains(x);
+      s.nearest = std::min(s.nearest, (x - region.center).squaredNorm());
+    };
+    for (const std::int32_t fi : sc_.work) {
+      const Face& f = mesh_.faces[static_cast<std::size_t>(fi)];
+      if (!in_section(f)) continue;
+      std::int32_t& id =
+          section_of[static_cast<std::size_t>(detail::find_root(parent.data(), f[0]))];
+      if (id < 0) id = static_cast<std::int32_t>(sections.size()), sections.emplace_back();
+      Section& s = sections[static_cast<std::size_t>(id)];
+      for (int k = 0; k < 3; ++k) {
+        const std::int32_t v = f[k], w = f[(k + 1) % 3];
+        if (sd[v] == 0) measure(s, point(v));
+        if (sd[v] * sd[w] < 0) measure(s, crossing_point(v, w)), s.crossed = true;
+      }
+    }
+    std::vector<std::uint8_t> kept(sections.size(), 0);
+    std::size_t nearest = sections.size();
+    for (std::size_t i = 0; i < sections.size(); ++i) {
+      const Section& s = sections[i];
+      if (!s.crossed) continue;
+      ++result_.sections;
+      if (region.shape == CutRegion::Shape::seed) {
+        if (nearest == sections.size() || s.nearest < sections[nearest].nearest) nearest = i;
+      } else {
+        kept[i] = region.keep == CutRegion::Keep::inside ? s.inside == s.points : s.inside > 0;
+      }
+    }
+    if (nearest < sections.size()) kept[nearest] = 1;
+    for (std::size_t i = 0; i < sections.size(); ++i) result_.kept_sections += kept[i];
+    std::erase_if(sc_.work, [&](std::int32_t fi) {
+      const Face& f = mesh_.faces[static_cast<std::size_t>(fi)];
+      if (!in_section(f)) return false;
+      const std::int32_t root = detail::find_root(parent.data(), f[0]);
+      return !kept[static_cast<std::size_t>(section_of[static_cast<std::size_t>(root)])];
+    });
+    return result_.kept_sections > 0;
   }
 
   // Step 3's vertex on crossed edge (u, w), made once for the faces on both sides.

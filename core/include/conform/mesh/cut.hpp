@@ -22,6 +22,11 @@
 //      loops inside loops (a hollow tube, a torus cut through its hole) give rings.
 // Pieces are then the connected components (label_pieces), so one plane may give many.
 //
+// Regional cuts: with options.region (cut_region.hpp), step 2's result is grouped into
+// sections (the crossed and touching faces, connected through shared vertices) and only the
+// sections the region keeps go on to steps 3–5; the rest of the mesh is untouched. A section
+// is kept or dropped whole, so a kept loop separates and caps as an unbounded cut's would.
+//
 // Sliver guarantee: every face the cut adds inside an original face (caps excluded: their
 // constrained Delaunay triangulation is bounded by the cut loop's own geometry) has smallest
 // angle ≥ min(min_angle, half the smallest angle of that original face). The default floor,
@@ -32,9 +37,10 @@
 // 11° corners); 5° keeps the deviation under half an edge on well-shaped meshes. Without the
 // angle rule (1 % snapping alone) the smallest added angle was 0.10°.
 //
-// Degenerate input: a non-finite or zero-normal plane, or non-finite positions, throw
-// std::invalid_argument; a plane that misses or only touches the mesh returns status Missed
-// with an empty change (a documented no-op).
+// Degenerate input: a non-finite or zero-normal plane, non-finite positions or an invalid
+// region (CutRegion::validate) throw std::invalid_argument; a plane that misses or only touches
+// the mesh, or crosses it only in sections the region drops, returns status Missed with an
+// empty change (a documented no-op).
 #pragma once
 
 #include <cstdint>
@@ -44,6 +50,7 @@
 #include "conform/cga/plane.hpp"
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/cap.hpp"
+#include "conform/mesh/cut_region.hpp"
 #include "conform/mesh/topology_change.hpp"
 
 namespace conform::mesh {
@@ -57,6 +64,7 @@ struct CutOptions {
   double min_angle = kCutMinAngle;  // sliver floor θ_floor, radians, in [0, 0.5); 0: off
   bool cap = false;
   SectionTriangulator cap_triangulator = SectionTriangulator::Best;
+  CutRegion region = {};  // default: everywhere (the unbounded plane)
 };
 
 enum class CutStatus { Cut, Missed };
@@ -69,9 +77,11 @@ struct CutResult {
   std::int32_t snapped_vertices = 0;  // vertices taken as on the plane by step 2 (snaps)
   std::int32_t loops = 0;             // closed cut loops found (when capping)
   std::int32_t capped_loops = 0;
-  std::int32_t nested_loops = 0;  // capped loops inside another loop (holes, islands)
-  std::int32_t cap_faces = 0;     // per side
-  std::string message;            // why a loop was not capped, when one was not
+  std::int32_t nested_loops = 0;   // capped loops inside another loop (holes, islands)
+  std::int32_t cap_faces = 0;      // per side
+  std::int32_t sections = 0;       // with a region: the sections the plane crosses
+  std::int32_t kept_sections = 0;  // with a region: those it kept (cut)
+  std::string message;             // why a loop was not capped, or why the cut missed
 };
 
 /// Computes the change without touching the mesh. O(V + F) for the classification, then
