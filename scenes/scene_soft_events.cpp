@@ -1,19 +1,15 @@
-// The soft-body scenes with one topology event or an animation, all on the Conform plugin:
+// The soft-body scenes of the arm with one topology event, on the Conform plugin (the
+// character scene, a user's model, is scene_character.cpp):
 //   cut        — a planar cut through the forearm of the moving arm; both pieces keep
 //                simulating under gravity, the hand piece stays skinned to its bones;
 //   drill      — a hole drilled through the upper arm, then the arm moves; the hole's rim
-//                stays on the skin (its nodes stay on their skinned targets);
-//   character  — a real rigged model plays its animation through CGA skinning, with soft-body
-//                secondary motion (nodes pulled toward their skinned targets).
+//                stays on the skin (its nodes stay on their skinned targets).
 // Every scene reports how far nodes are from their skinned targets ("offset"), the measure of
 // following the skin.
 #include <chrono>
 #include <cmath>
-#include <filesystem>
-#include <iostream>
 #include <numbers>
 
-#include "conform/io/import.hpp"
 #include "conform/mesh/analysis.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
@@ -54,21 +50,6 @@ constexpr const char* kDrillJson = R"json({
                "gravity": [0, -9.81, 0] },
   "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
 })json";
-// The built-in scene `character`, the defaults of this kind (`conform scenes --show character`).
-constexpr const char* kCharacterJson = R"json({
-  "scene": "character",
-  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body: nodes close to one bone ride it, blended regions follow their skinned targets softly.",
-  "seed": 1,
-  "duration": 1.56,
-  "model": { "file": "/usr/share/assimp/models/FBX/huesitos.fbx", "animation": "0",
-             "units_per_metre": 100 },
-  "material": { "link_stiffness": 0.02, "target_stiffness": 2000, "target_damping": 20,
-                "kinematic_weight": 0.95, "damping": 0.01 },
-  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
-               "gravity": [0, -9.81, 0] },
-  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
-})json";
-
 using Clock = std::chrono::steady_clock;
 using Vec3 = Eigen::Vector3d;
 constexpr double kPi = std::numbers::pi;
@@ -105,32 +86,6 @@ Vec3 carried(const skin::Skeleton& sk, const ArmMotion& motion, double t, int bo
   skin::global_versors(sk, p, global);
   skin::skinning_versors(sk, global, versors);
   return versors[static_cast<std::size_t>(bone)].apply(x);
-}
-
-struct OffsetStats {
-  double mean = 0, max = 0;
-  long n = 0;
-};
-// Distances of `vertices` (all when empty) from their skinned targets.
-OffsetStats offsets(const bullet::SkinnedSoftBody& body,
-                    const std::vector<std::int32_t>& vertices) {
-  OffsetStats s;
-  const auto add = [&](std::int32_t v) {
-    const double d = (body.position(v) - body.target(v)).norm();
-    s.mean += d, s.max = std::max(s.max, d), ++s.n;
-  };
-  if (vertices.empty())
-    for (std::int32_t v = 0; v < body.vertex_count(); ++v) add(v);
-  else
-    for (const std::int32_t v : vertices) add(v);
-  if (s.n) s.mean /= double(s.n);
-  return s;
-}
-
-bool finite_nodes(const bullet::SkinnedSoftBody& body) {
-  for (std::int32_t v = 0; v < body.vertex_count(); ++v)
-    if (!body.position(v).allFinite()) return false;
-  return true;
 }
 
 bullet::Material arm_material() {
@@ -364,144 +319,12 @@ class ArmEventScene : public Scene {
   bool cap_ = false;
 };
 
-// The fastest node after the first step and the fastest target motion over it (model units/s).
-struct FirstStep {
-  double node_speed = 0, target_speed = 0;
-};
-
-FirstStep first_step(const bullet::SkinnedSoftBody& body,
-                     const std::vector<Eigen::Vector3d>& start_targets, double dt) {
-  FirstStep f;
-  for (std::int32_t v = 0; v < body.vertex_count(); ++v) {
-    if (body.detached(v)) continue;
-    f.node_speed = std::max(f.node_speed, body.velocity(v).norm());
-    f.target_speed = std::max(
-        f.target_speed, (body.target(v) - start_targets[static_cast<std::size_t>(v)]).norm() / dt);
-  }
-  return f;
-}
-
-class Character final : public Scene {
- public:
-  Character(const Json& scene, const std::string& name, int steps_override) {
-    Reader root(scene, "", resolved_);
-    Reader model = root.object("model");
-    file_ = model.text("file", "/usr/share/assimp/models/FBX/huesitos.fbx");
-    if (file_.rfind("arm", 0) != 0 && !std::filesystem::exists(file_))
-      model.fail("file", Json(file_), "no such file");
-    animation_ = model.text("animation", "0");
-    units_ = model.number("units_per_metre", 1, 1e-6, 1e6);
-    import_.strict_weights = model.boolean("strict_weights", false);
-    import_.isolate = true;  // a corrupt file must not kill or corrupt the run
-    model.finish();
-    bullet::Material d;
-    // Real characters come at any scale (units_per_metre) and their animations stretch the
-    // skin far from the bind pose; the SI membrane on them is not validated yet, so this scene
-    // keeps Bullet's soft links (material.model = "membrane" to try it).
-    d.model = bullet::MaterialModel::bullet_links;
-    d.kinematic_weight = 0.95;  // nodes near one bone ride it; blended regions jiggle
-    // The animation stretches the skin (edge lengths change), which stiff links at bind-pose
-    // rest lengths would fight: soft links, and a firm pull toward the skinned targets.
-    d.link_stiffness = 0.02;
-    d.target_stiffness = 2000;
-    d.target_damping = 20;
-    d.damping = 0.01;
-    material_ = read_material(root, d);
-    common_ = read_common(root, name, 3.0, steps_override);
-    root.finish();
-  }
-
-  Json run(RunOutput& out) override {
-    CommonSettings c = common_;
-    io::SkinnedModel model = io::load_model(file_, import_);
-    for (const auto& w : model.warnings)
-      std::cerr << "warning: " << model.source << ": " << w << "\n";
-    const int a = model.find_animation(animation_);
-    if (a < 0)
-      throw std::runtime_error(file_ + ": no animation '" + animation_ + "' (" +
-                               std::to_string(model.animations.size()) + " animations)");
-    c.gravity *= units_;  // metres → the model's units
-    bullet::Material material = material_;
-    material.margin *= units_;
-    SoftWorld w(c);
-    bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(model, material);
-    // No loop: this animation's last key is not its first, and the wrap would be a jump.
-    body.play(model.animations[static_cast<std::size_t>(a)], skin::Blend::log, false);
-    body.snap_to_pose();  // start at the animation's first pose, not the bind pose (no spike)
-    std::vector<Eigen::Vector3d> start_targets(static_cast<std::size_t>(body.vertex_count()));
-    for (std::int32_t v = 0; v < body.vertex_count(); ++v)
-      start_targets[static_cast<std::size_t>(v)] = body.target(v);
-    FirstStep first{};
-    std::int32_t kinematic = 0;
-    for (std::int32_t v = 0; v < body.vertex_count(); ++v) kinematic += body.kinematic(v);
-    out.open_metrics({"t", "offset_mean", "offset_max", "offset_mean_m", "offset_max_m"});
-    double worst = 0, mean_sum = 0;
-    out.frame("character", 0, body.mesh());
-    const auto loop_start = Clock::now();
-    for (int step = 1; step <= c.steps; ++step) {
-      w.step();
-      if (step == 1) first = first_step(body, start_targets, c.dt);
-      const OffsetStats o = offsets(body, {});
-      worst = std::max(worst, o.max), mean_sum += o.mean;
-      if (step % c.metrics_every == 0 || step == c.steps) {
-        const double row[] = {step * c.dt, o.mean, o.max, o.mean / units_, o.max / units_};
-        out.metrics().row(row);
-      }
-      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
-        body.sync_mesh();
-        out.frame("character", step, body.mesh());
-      }
-      out.progress(step, c.steps);
-    }
-    const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
-    if (!finite_nodes(body)) throw std::runtime_error("the soft body blew up (non-finite nodes)");
-    Json metrics = {
-        {"model", file_},
-        {"animation", model.animations[static_cast<std::size_t>(a)].name},
-        // The first step's fastest node against the fastest motion of the skinned targets
-        // over that step (the animation itself), m/s.
-        {"first_step_max_node_speed_m_s", first.node_speed / units_},
-        {"first_step_max_target_speed_m_s", first.target_speed / units_},
-        {"animation_duration_s", model.animations[static_cast<std::size_t>(a)].duration()},
-        {"vertices", body.vertex_count()},
-        {"faces", model.mesh.face_count()},
-        {"bones", model.skeleton.bone_count()},
-        {"kinematic_nodes", kinematic},
-        {"pieces", body.piece_count()},
-        {"secondary_motion_mean_m", mean_sum / c.steps / units_},
-        {"secondary_motion_max_m", worst / units_},
-        {"units",
-         "secondary motion = distance of a node from its CGA-skinned target, "
-         "metres (model units / units_per_metre)"}};
-    out.add_plot({"secondary_motion",
-                  "character: soft-body secondary motion",
-                  "time [s]",
-                  "distance from skinned target [m]",
-                  {{"metrics.csv", "t", "offset_mean_m", "mean over nodes", "lines"},
-                   {"metrics.csv", "t", "offset_max_m", "largest", "lines"}},
-                  {}});
-    out.finish(resolved_, metrics, {{"model_vertices", model.mesh.vertex_count()}}, c.steps,
-               c.steps * c.dt, loop_s);
-    return metrics;
-  }
-
- private:
-  std::string file_, animation_;
-  io::ImportOptions import_;
-  double units_ = 1;
-  bullet::Material material_;
-};
-
 std::unique_ptr<Scene> make_cut(const Json& scene, const std::string& name, int steps) {
   return std::make_unique<ArmEventScene>(ArmEventScene::Kind::cut, scene, name, steps);
 }
 std::unique_ptr<Scene> make_drill(const Json& scene, const std::string& name, int steps) {
   return std::make_unique<ArmEventScene>(ArmEventScene::Kind::drill, scene, name, steps);
 }
-std::unique_ptr<Scene> make_character(const Json& scene, const std::string& name, int steps) {
-  return std::make_unique<Character>(scene, name, steps);
-}
-
 const SceneRegistration kCutRegistration{
     {"cut",
      "a planar cut through the forearm of the moving soft arm; the pieces keep simulating under "
@@ -511,11 +334,5 @@ const SceneRegistration kDrillRegistration{
     {"drill",
      "a hole drilled through the upper arm, then the arm moves; the hole's rim stays on the skin",
      kDrillJson, &make_drill, 3, "offset_max,offset_mean"}};
-const SceneRegistration kCharacterRegistration{
-    {"character",
-     "a real rigged model (assimp) plays its animation through CGA skinning with soft-body "
-     "secondary motion",
-     kCharacterJson, &make_character, 4, "secondary_motion_max_m"}};
-
 }  // namespace
 }  // namespace conform::scenes

@@ -1,5 +1,6 @@
 #include "soft_scene.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "conform/bullet/convert.hpp"
@@ -10,6 +11,27 @@ SoftWorld::SoftWorld(const CommonSettings& c)
     : bullet::SoftWorld(bullet::to_bt(c.gravity)), dt(c.dt / c.substeps), substeps(c.substeps) {
   world.getSolverInfo().m_numIterations = c.solver_iterations;
   plugin = std::make_unique<bullet::Plugin>(world);
+}
+
+OffsetStats offsets(const bullet::SkinnedSoftBody& body,
+                    const std::vector<std::int32_t>& vertices) {
+  OffsetStats s;
+  const auto add = [&](std::int32_t v) {
+    const double d = (body.position(v) - body.target(v)).norm();
+    s.mean += d, s.max = std::max(s.max, d), ++s.n;
+  };
+  if (vertices.empty())
+    for (std::int32_t v = 0; v < body.vertex_count(); ++v) add(v);
+  else
+    for (const std::int32_t v : vertices) add(v);
+  if (s.n) s.mean /= double(s.n);
+  return s;
+}
+
+bool finite_nodes(const bullet::SkinnedSoftBody& body) {
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+    if (!body.position(v).allFinite()) return false;
+  return true;
 }
 
 // The membrane's fields (SI units; skin_material.hpp has their ranges and sources).

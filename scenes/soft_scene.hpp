@@ -26,6 +26,16 @@ struct SoftWorld : bullet::SoftWorld {
   void step() { bullet::SoftWorld::step(dt, substeps); }
 };
 
+/// Distances of nodes from their skinned targets.
+struct OffsetStats {
+  double mean = 0, max = 0;
+  long n = 0;
+};
+/// Over `vertices` (all when empty).
+OffsetStats offsets(const bullet::SkinnedSoftBody& body, const std::vector<std::int32_t>& vertices);
+/// Every node position finite.
+bool finite_nodes(const bullet::SkinnedSoftBody& body);
+
 /// Reads the "material" object (every key of bullet::Material), with scene-specific defaults.
 bullet::Material read_material(Reader& root, const bullet::Material& defaults);
 

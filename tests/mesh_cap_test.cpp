@@ -257,6 +257,41 @@ TEST(Section, EarClippingEndsConstrainedDelaunay) {
   RecordProperty("min_angle_degrees", std::to_string(min_angle * 180 / M_PI));
 }
 
+TEST(Section, ForbiddenDiagonalsAreNotUsed) {
+  // A convex octagon whose Delaunay triangulation would use diagonals from vertex 0: with
+  // all of them forbidden (a cut passes the mesh edges in the plane so), no triangle joins 0
+  // to a vertex other than its neighbours, and the octagon is still covered (6 triangles of
+  // its area). A square with both diagonals forbidden cannot be triangulated: a problem.
+  Loops octagon(1);
+  for (int i = 0; i < 8; ++i)
+    octagon[0].emplace_back(std::cos(2 * M_PI * i / 8), 0.6 * std::sin(2 * M_PI * i / 8));
+  ForbiddenDiagonals from0;
+  for (std::int32_t v = 2; v <= 6; ++v) from0.push_back({v, 0});
+  for (const auto method : {SectionTriangulator::EarClipping, SectionTriangulator::Best}) {
+    const SectionTriangulation s = triangulate_section(octagon, method, from0);
+    ASSERT_TRUE(s.ok()) << s.problem;
+    ASSERT_EQ(s.triangles.size(), 6u);
+    double area = 0;
+    for (const auto& t : s.triangles) {
+      const Eigen::Vector2d a = octagon[0][std::size_t(t[0])], b = octagon[0][std::size_t(t[1])],
+                            c = octagon[0][std::size_t(t[2])];
+      area += 0.5 * ((b - a).x() * (c - a).y() - (b - a).y() * (c - a).x());
+      for (int k = 0; k < 3; ++k) {
+        const std::int32_t u = t[std::size_t(k)], w = t[std::size_t((k + 1) % 3)];
+        if (u == 0 || w == 0) {
+          EXPECT_TRUE(u + w == 1 || u + w == 7) << u << "-" << w;
+        }
+      }
+    }
+    EXPECT_NEAR(area, polygon_area(octagon[0]), 1e-12);
+  }
+  const Loops square = {{{0, 0}, {1, 0}, {1, 1}, {0, 1}}};
+  const SectionTriangulation none =
+      triangulate_section(square, SectionTriangulator::Best, {{0, 2}, {1, 3}});
+  EXPECT_FALSE(none.ok());
+  EXPECT_TRUE(none.triangles.empty());
+}
+
 TEST(CapNested, HollowTubeCutAcross) {
   const SkinnedMesh in = thick_tube();
   ASSERT_TRUE(check_mesh(in).closed());

@@ -432,17 +432,16 @@ TEST(Cut, ReDeformation) {
 TEST(Cut, PropertyRealModels) {
   // Real rigged models from assimp-testmodels (they need not be closed or manifold: the
   // invariants that hold for the input are checked).
-  int cuts = 0;
+  int cuts = 0, pinched = 0;
   for (const char* file :
        {"FBX/huesitos.fbx", "X/anim_test.x", "glTF2/simple_skin/simple_skin.gltf"}) {
     const std::filesystem::path path = std::filesystem::path(CONFORM_ASSIMP_MODELS) / file;
     if (!std::filesystem::exists(path)) continue;
-    // As the files are split at their seams (the welded models: mesh_weld_test.cpp). Welded,
-    // huesitos.fbx is closed, and capped trial 184 leaves one edge used by three faces: a
-    // cap defect that the seams used to hide (open curves were not capped), not fixed yet.
-    io::ImportOptions split;
-    split.weld = false;
-    const SkinnedMesh in = io::load_model(path.string(), split).mesh;
+    // Welded, as users get them. Welded, huesitos.fbx is closed, and in capped trial 184 two
+    // vertices snapped onto the plane make a mesh edge in the plane with both faces on the
+    // positive side (a crease touching the plane): the section triangulation must not use it
+    // as a diagonal, or that edge gets four faces (cap.hpp, forbidden diagonals).
+    const SkinnedMesh in = io::load_model(path.string()).mesh;
     std::mt19937 rng(99);
     for (int trial = 0; trial < 200; ++trial) {
       SkinnedMesh m = in;
@@ -455,9 +454,18 @@ TEST(Cut, PropertyRealModels) {
       expect_area_kept(in, m, out.result, what);
       EXPECT_GE(added_face_angles(in, m, kCutMinAngle, cap_faces(out.result)).worst_ratio, 1 - 1e-9)
           << what << ": a sliver";
+      // Every loop is capped but those through a vertex where the surface touches the plane
+      // in several fans (a documented limit: 4 of huesitos' 92 capped trials).
+      if (trial % 2 == 0 && out.result.capped_loops < out.result.loops) {
+        ++pinched;
+        EXPECT_NE(out.result.message.find("several fans"), std::string::npos)
+            << what << ": " << out.result.message;
+      }
       if (testing::Test::HasFailure()) return;
     }
   }
   if (cuts == 0) GTEST_SKIP() << "assimp-testmodels not installed";
   EXPECT_GT(cuts, 100);
+  EXPECT_LE(pinched, 10);
+  RecordProperty("uncapped_pinched_trials", pinched);
 }

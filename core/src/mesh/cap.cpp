@@ -12,6 +12,33 @@ namespace {
 
 using Pts = std::vector<Eigen::Vector2d>;
 
+// The forbidden diagonals (cap.hpp) as sorted (low, high) pairs; empty: none.
+class Forbidden {
+ public:
+  Forbidden() = default;
+  explicit Forbidden(const ForbiddenDiagonals& pairs) {
+    for (const auto& [a, b] : pairs) pairs_.push_back({std::min(a, b), std::max(a, b)});
+    std::sort(pairs_.begin(), pairs_.end());
+  }
+  bool empty() const { return pairs_.empty(); }
+  bool operator()(std::int32_t a, std::int32_t b) const {
+    return !pairs_.empty() &&
+           std::binary_search(pairs_.begin(), pairs_.end(),
+                              std::array<std::int32_t, 2>{std::min(a, b), std::max(a, b)});
+  }
+  // True when a triangle of `t` has a forbidden edge.
+  bool used_by(const std::vector<std::array<std::int32_t, 3>>& t) const {
+    for (const auto& tri : t)
+      for (int k = 0; k < 3; ++k)
+        if ((*this)(tri[static_cast<std::size_t>(k)], tri[static_cast<std::size_t>((k + 1) % 3)]))
+          return true;
+    return false;
+  }
+
+ private:
+  std::vector<std::array<std::int32_t, 2>> pairs_;
+};
+
 double twice_area(const Pts& p, const std::vector<std::int32_t>& idx) {
   double a = 0;
   for (std::size_t i = 0; i < idx.size(); ++i) {
@@ -48,7 +75,7 @@ double cross(const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Ve
 // unless a reflex one does too. A nearly convex loop, the usual cut section, is therefore
 // clipped in O(n) rather than O(n²).
 bool ear_clip(const Pts& p, const std::vector<std::int32_t>& poly,
-              std::vector<std::array<std::int32_t, 3>>& out) {
+              std::vector<std::array<std::int32_t, 3>>& out, const Forbidden& forbidden) {
   const auto m = static_cast<std::int32_t>(poly.size());
   if (m < 3) return false;
   auto P = [&](std::int32_t node) -> const Eigen::Vector2d& {
@@ -79,7 +106,8 @@ bool ear_clip(const Pts& p, const std::vector<std::int32_t>& poly,
   while (left > 3) {
     if (misses >= left) return false;  // a whole round without an ear
     const std::int32_t b = cur, a = at(prev, b), c = at(next, b);
-    bool ear = reflex[static_cast<std::size_t>(b)] == 0;
+    bool ear = reflex[static_cast<std::size_t>(b)] == 0 &&
+               !forbidden(poly[static_cast<std::size_t>(a)], poly[static_cast<std::size_t>(c)]);
     if (ear) {
       const Eigen::Vector2d &A = P(a), &B = P(b), &C = P(c);
       for (const std::int32_t q : blockers) {
@@ -132,7 +160,8 @@ bool ear_clip(const Pts& p, const std::vector<std::int32_t>& poly,
       for (std::size_t k = 0; k < 3; ++k)
         if (out[t][k] == a && out[t][(k + 1) % 3] == c) {
           const std::int32_t d = out[t][(k + 2) % 3];
-          if (cross(Q(a), Q(b), Q(d)) <= eps || cross(Q(b), Q(c), Q(d)) <= eps) return false;
+          if (cross(Q(a), Q(b), Q(d)) <= eps || cross(Q(b), Q(c), Q(d)) <= eps || forbidden(b, d))
+            return false;
           out[t] = {a, b, d};
           out.push_back({b, c, d});
           return true;
@@ -275,7 +304,8 @@ bool bridge(const Pts& p, std::vector<std::int32_t>& poly, const std::vector<std
 //
 // Half-edge h = 3 i + k runs from t[first + i][k] to t[first + i][k + 1]; twins are paired
 // once by sorting the undirected edges, then kept up to date across flips (no hashing).
-void delaunay_flips(const Pts& p, std::vector<std::array<std::int32_t, 3>>& t, std::size_t first) {
+void delaunay_flips(const Pts& p, std::vector<std::array<std::int32_t, 3>>& t, std::size_t first,
+                    const Forbidden& forbidden = {}) {
   const std::size_t n = t.size() - first;
   if (n < 2) return;
   auto P = [&](std::int32_t i) -> const Eigen::Vector2d& { return p[static_cast<std::size_t>(i)]; };
@@ -338,7 +368,7 @@ void delaunay_flips(const Pts& p, std::vector<std::array<std::int32_t, 3>>& t, s
                        b = ti[static_cast<std::size_t>((k + 1) % 3)],
                        c = ti[static_cast<std::size_t>((k + 2) % 3)],
                        d = tj[static_cast<std::size_t>((l + 2) % 3)];
-    if (!(incircle(a, b, c, d) > eps_circle)) continue;
+    if (!(incircle(a, b, c, d) > eps_circle) || forbidden(c, d)) continue;
     // (a, b, c) and (b, a, d) → (a, d, c) and (d, b, c), when both turn counter-clockwise.
     if (!(cross(P(a), P(d), P(c)) > eps_area) || !(cross(P(d), P(b), P(c)) > eps_area)) continue;
     const std::int32_t bc = twin[static_cast<std::size_t>(3 * i + (k + 1) % 3)],
@@ -354,7 +384,8 @@ void delaunay_flips(const Pts& p, std::vector<std::array<std::int32_t, 3>>& t, s
   }
 }
 
-bool ear_clip_section(const std::vector<Pts>& loops, SectionTriangulation& out) {
+bool ear_clip_section(const std::vector<Pts>& loops, SectionTriangulation& out,
+                      const Forbidden& forbidden = {}) {
   Pts p;
   std::vector<std::vector<std::int32_t>> idx(loops.size());
   for (std::size_t l = 0; l < loops.size(); ++l)
@@ -400,13 +431,13 @@ bool ear_clip_section(const std::vector<Pts>& loops, SectionTriangulation& out) 
         out.problem = "a hole of the section could not be bridged to its outer loop";
         return false;
       }
-    if (!(holes.empty() && convex_strip(p, poly, out.triangles)) &&
-        !ear_clip(p, poly, out.triangles)) {
+    if (!(holes.empty() && forbidden.empty() && convex_strip(p, poly, out.triangles)) &&
+        !ear_clip(p, poly, out.triangles, forbidden)) {
       out.problem = "a loop whose projection is not a simple polygon";
       return false;
     }
   }
-  delaunay_flips(p, out.triangles, 0);
+  delaunay_flips(p, out.triangles, 0, forbidden);
   return true;
 }
 
@@ -536,23 +567,11 @@ bool has_cgal_triangulator() {
   return detail::cdt_available();
 }
 
-SectionTriangulation triangulate_section(const std::vector<std::vector<Eigen::Vector2d>>& loops,
-                                         SectionTriangulator method) {
-  SectionTriangulation out;
-  for (const auto& l : loops) {
-    if (l.size() < 3) {
-      out.problem = "a loop with fewer than 3 vertices";
-      return out;
-    }
-    for (const auto& q : l)
-      if (!q.allFinite()) {
-        out.problem = "a non-finite loop vertex";
-        return out;
-      }
-  }
-  if (method == SectionTriangulator::Best)
-    method = detail::cdt_available() ? SectionTriangulator::ConstrainedDelaunay
-                                     : SectionTriangulator::EarClipping;
+namespace {
+
+// The triangulation by `method` (not Best), forbidden diagonals aside; false when it failed.
+bool triangulate_as_asked(const std::vector<Pts>& loops, SectionTriangulator method,
+                          SectionTriangulation& out) {
   auto triangulate = [&](const std::vector<Pts>& l) {
     return method == SectionTriangulator::ConstrainedDelaunay ? detail::cdt_section(l, out)
                                                               : ear_clip_section(l, out);
@@ -575,6 +594,42 @@ SectionTriangulation triangulate_section(const std::vector<std::vector<Eigen::Ve
   if (!ok) {  // no flat vertices, or the corners alone did not triangulate: the loops as given
     out = SectionTriangulation{};
     ok = triangulate(loops);
+  }
+  return ok;
+}
+
+}  // namespace
+
+SectionTriangulation triangulate_section(const std::vector<std::vector<Eigen::Vector2d>>& loops,
+                                         SectionTriangulator method,
+                                         const ForbiddenDiagonals& forbidden_pairs) {
+  SectionTriangulation out;
+  for (const auto& l : loops) {
+    if (l.size() < 3) {
+      out.problem = "a loop with fewer than 3 vertices";
+      return out;
+    }
+    for (const auto& q : l)
+      if (!q.allFinite()) {
+        out.problem = "a non-finite loop vertex";
+        return out;
+      }
+  }
+  if (method == SectionTriangulator::Best)
+    method = detail::cdt_available() ? SectionTriangulator::ConstrainedDelaunay
+                                     : SectionTriangulator::EarClipping;
+  bool ok = triangulate_as_asked(loops, method, out);
+  const Forbidden forbidden(forbidden_pairs);
+  if (ok && forbidden.used_by(out.triangles)) {
+    // Again by ear clipping that avoids them (the constrained Delaunay cannot be told to).
+    out = SectionTriangulation{};
+    ok = ear_clip_section(loops, out, forbidden);
+    if (ok && forbidden.used_by(out.triangles)) {  // only a hole's bridge can still use one
+      ok = false;
+      out.problem =
+          "the section cannot be triangulated without joining two loop vertices "
+          "that a mesh edge in the plane already joins";
+    }
   }
   if (!ok) {
     out.triangles.clear();

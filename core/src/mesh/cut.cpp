@@ -675,7 +675,7 @@ class CutComputation {
     chain_boundary();
     std::vector<std::string> problems;
     std::vector<std::vector<Eigen::Vector2d>> loops2 = closed_loops(problems);
-    if (!loops2.empty()) add_cap_faces(loops2, problems);
+    if (!loops2.empty()) add_cap_faces(loops2, forbidden_diagonals(), problems);
     if (!problems.empty()) result_.message = "not capped: " + problems.front();
   }
 
@@ -752,6 +752,38 @@ class CutComputation {
     }
   }
 
+  // Edges of the mesh in the plane whose faces are on one side (a crease of that side touching
+  // the plane): they join two loop vertices through the section, and a cap triangle on one
+  // would be a third face of that edge. As indices into sc_.ids, for the triangulation to avoid.
+  ForbiddenDiagonals forbidden_diagonals() const {
+    auto edge_key = [](std::int32_t u, std::int32_t w) {
+      return (std::uint64_t(std::uint32_t(u)) << 32) | std::uint32_t(w);
+    };
+    std::vector<std::int32_t> at(nloop_, -1);  // local id → index in sc_.ids
+    for (std::size_t i = 0; i < sc_.ids.size(); ++i)
+      at[static_cast<std::size_t>(sc_.ids[i])] = static_cast<std::int32_t>(i);
+    ForbiddenDiagonals out;
+    for (const int side : {1, -1}) {
+      std::vector<std::uint64_t> edges;
+      for (std::size_t i = 0; i < sc_.pending.size(); ++i)
+        if (sc_.pending[i].side == side)
+          for (int k = 0; k < 3; ++k) {
+            const std::int32_t u = sc_.pending_local[i][k], w = sc_.pending_local[i][(k + 1) % 3];
+            if (u >= 0 && w >= 0) edges.push_back(edge_key(u, w));
+          }
+      std::sort(edges.begin(), edges.end());
+      for (const std::uint64_t e : edges) {
+        const auto u = static_cast<std::int32_t>(e >> 32),
+                   w = static_cast<std::int32_t>(e & 0xffffffffu);
+        const std::int32_t a = at[static_cast<std::size_t>(u)], b = at[static_cast<std::size_t>(w)];
+        if (u < w && a >= 0 && b >= 0 &&
+            std::binary_search(edges.begin(), edges.end(), edge_key(w, u)))
+          out.push_back({a, b});
+      }
+    }
+    return out;
+  }
+
   // The closed, unambiguous loops, projected on the plane's frame (e1, e2, n); their local
   // ids concatenated in sc_.ids.
   std::vector<std::vector<Eigen::Vector2d>> closed_loops(std::vector<std::string>& problems) {
@@ -800,8 +832,9 @@ class CutComputation {
   // counter-clockwise about n: the negative piece's cap faces +n as they are, the positive
   // piece's is reversed.
   void add_cap_faces(const std::vector<std::vector<Eigen::Vector2d>>& loops2,
-                     std::vector<std::string>& problems) {
-    const SectionTriangulation section = triangulate_section(loops2, options_.cap_triangulator);
+                     const ForbiddenDiagonals& forbidden, std::vector<std::string>& problems) {
+    const SectionTriangulation section =
+        triangulate_section(loops2, options_.cap_triangulator, forbidden);
     if (!section.ok()) {
       problems.push_back(section.problem);
       return;

@@ -27,6 +27,13 @@
 //                        Always available; the fallback, and faster than CGAL's on the cut's
 //                        small sections.
 // Neither adds vertices: every triangle joins three loop vertices.
+//
+// Forbidden diagonals: pairs of loop vertices that the triangulation must not join (a cut
+// passes them in: an edge of the mesh that lies in the plane between two loop vertices, with
+// its faces on one side, is a diagonal of the section, and a cap triangle on it would give that
+// edge a third and fourth face). When the first triangulation uses one, the section is
+// triangulated again by ear clipping that clips no ear whose diagonal is forbidden and flips
+// no edge into one; if that fails too, a problem is reported.
 #pragma once
 
 #include <Eigen/Core>
@@ -47,11 +54,16 @@ struct SectionTriangulation {
   bool ok() const { return problem.empty(); }
 };
 
+/// Pairs of loop vertices (indices into the loops' vertices concatenated) that no triangle
+/// may join by a diagonal.
+using ForbiddenDiagonals = std::vector<std::array<std::int32_t, 2>>;
+
 /// Triangulates the section bounded by `loops` with `method` (Best: constrained Delaunay
-/// when available, else ear clipping). Requesting ConstrainedDelaunay without CGAL reports
-/// a problem.
+/// when available, else ear clipping), using none of the `forbidden` diagonals (see above).
+/// Requesting ConstrainedDelaunay without CGAL reports a problem.
 SectionTriangulation triangulate_section(const std::vector<std::vector<Eigen::Vector2d>>& loops,
-                                         SectionTriangulator method = SectionTriangulator::Best);
+                                         SectionTriangulator method = SectionTriangulator::Best,
+                                         const ForbiddenDiagonals& forbidden = {});
 
 /// True when this build has CGAL's constrained Delaunay triangulation.
 bool has_cgal_triangulator();
