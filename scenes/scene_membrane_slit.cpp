@@ -27,7 +27,7 @@ constexpr const char* kMembraneSlitJson = R"json({
   "slit": { "length": 0.05, "angle_deg": 0, "at": 0.1 },
   "material": { "prestress": [400, 400], "youngs_modulus": 420000, "poisson_ratio": 0.48,
                 "thickness": 0.0015, "attachment_stiffness": 0,
-                "attachment_normal_stiffness": 0, "tolerance": 0.4, "max_cg_iterations": 4000 },
+                "attachment_normal_stiffness": 0, "wrinkling": false, "tolerance": 0.4, "max_cg_iterations": 4000 },
   "physics": { "dt": 0.016666666666666666, "substeps": 1, "gravity": [0, 0, 0] },
   "outputs": { "metrics_every": 1, "frames_every": 0, "plots": true }
 })json";

@@ -50,6 +50,7 @@ void read_skin(Reader& r, const bullet::Material& d, bullet::Material& m) {
   k.attachment_normal_stiffness =
       r.number("attachment_normal_stiffness", e.attachment_normal_stiffness, 0, 1e12);
   k.attachment_damping = r.number("attachment_damping", e.attachment_damping, 0, 1e9);
+  k.wrinkling = r.boolean("wrinkling", e.wrinkling);
   m.solver.tolerance = r.number("tolerance", d.solver.tolerance, 1e-9, 1e9);
   m.solver.max_newton_iterations =
       r.integer("max_newton_iterations", d.solver.max_newton_iterations, 1, 10000);

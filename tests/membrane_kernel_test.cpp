@@ -58,8 +58,8 @@ TEST(MembraneKernel, HessianActionIsTheDerivativeOfTheGradientInTension) {
     Model model;
     model.build(t.rest, t.faces, anisotropic());
     const detail::ElementRest& e = model.elements()[0];
-    const detail::ElementState s =
-        detail::element_state(e, t.x.col(0), t.x.col(1), t.x.col(2), model.lambda(), model.mu());
+    const detail::ElementState s = detail::element_state(
+        e, t.x.col(0), t.x.col(1), t.x.col(2), model.lambda(), model.mu(), model.wrinkling());
     ASSERT_TRUE((s.s_pos - (s.f.transpose() * s.f).inverse() * s.f.transpose() * s.p).norm() <
                 1e-6 * s.s_pos.norm());
     Eigen::Matrix3Xd d = Eigen::Matrix3Xd::Random(3, 3);

@@ -28,6 +28,7 @@ SlitResult solve_slit(const SlitSheetOptions& options, double sxx, double syy) {
   material.prestress_axis = Eigen::Vector3d::UnitX();
   material.attachment_stiffness = 0;
   material.attachment_normal_stiffness = 0;
+  material.wrinkling = false;  // LEFM is linear elasticity: its sheet carries compression
   Model model;
   model.build(sheet.mesh.rest, sheet.mesh.faces, material);
   std::vector<std::uint8_t> fixed(sheet.border);

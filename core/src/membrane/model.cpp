@@ -117,10 +117,10 @@ double Model::energy(const Eigen::Ref<const Eigen::Matrix3Xd>& x) const {
   double total = 0;
   for (std::size_t e = 0; e < elements_.size(); ++e) {
     const mesh::Face& f = faces_[e];
-    const detail::Mat32 F =
-        detail::deformation_gradient(elements_[e], x.col(f[0]), x.col(f[1]), x.col(f[2]));
-    total += elements_[e].area_thickness *
-             detail::energy_density(elements_[e], detail::green_strain(F), lambda_, mu_);
+    total +=
+        elements_[e].area_thickness * detail::element_forces(elements_[e], x.col(f[0]), x.col(f[1]),
+                                                             x.col(f[2]), lambda_, mu_, wrinkling())
+                                          .psi;
   }
   return total;
 }
@@ -130,8 +130,8 @@ void Model::gradient(const Eigen::Ref<const Eigen::Matrix3Xd>& x,
   g.setZero();
   for (std::size_t e = 0; e < elements_.size(); ++e) {
     const mesh::Face& f = faces_[e];
-    const detail::ElementState s =
-        detail::element_forces(elements_[e], x.col(f[0]), x.col(f[1]), x.col(f[2]), lambda_, mu_);
+    const detail::ElementState s = detail::element_forces(elements_[e], x.col(f[0]), x.col(f[1]),
+                                                          x.col(f[2]), lambda_, mu_, wrinkling());
     for (int c = 0; c < 3; ++c)
       g.col(f[c]) += elements_[e].area_thickness * s.p * detail::beta_of(elements_[e], c);
   }

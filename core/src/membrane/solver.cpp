@@ -107,7 +107,8 @@ detail::ElementState forces_at(const Context& c, std::int64_t e,
                                const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
   const mesh::Face& f = c.model.element_faces()[static_cast<std::size_t>(e)];
   return detail::element_forces(c.model.elements()[static_cast<std::size_t>(e)], x.col(f[0]),
-                                x.col(f[1]), x.col(f[2]), c.model.lambda(), c.model.mu());
+                                x.col(f[1]), x.col(f[2]), c.model.lambda(), c.model.mu(),
+                                c.model.wrinkling());
 }
 
 // Phase 2: every element's deformation gradient, stresses and energy density (parallel over

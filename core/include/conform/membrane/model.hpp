@@ -33,6 +33,7 @@ class Model {
   const SkinMaterial& material() const { return material_; }
   double lambda() const { return lambda_; }
   double mu() const { return mu_; }
+  bool wrinkling() const { return material_.wrinkling; }
 
   /// A third of the rest area of the vertex's faces, m^2 (0 for a vertex without faces).
   double node_area(std::int32_t v) const { return node_area_[static_cast<std::size_t>(v)]; }

@@ -57,6 +57,12 @@ struct SkinMaterial {
   /// Viscous damping of the velocity relative to the target's, Pa s/m = N s/m^3, >= 0
   /// (default 1.6e3 Pa s/m).
   double attachment_damping = 1.6e3;
+  /// Wrinkling: the membrane carries no compression (tension-field theory, Pipkin 1986): where
+  /// a principal stress would go negative the skin buckles out of its plane instead, and the
+  /// relaxed energy of detail/tension_field.hpp is used (default true). false keeps the plain
+  /// StVK membrane, which carries compression like a plate in its plane (linear elasticity's
+  /// assumption, e.g. for comparison with LEFM).
+  bool wrinkling = true;
 
   /// Plane-stress Lame constants: lambda = E nu / (1 - nu^2), mu = E / (2 (1 + nu)), Pa.
   double lame_lambda() const;

@@ -17,10 +17,18 @@
 // Diagonal 3 x 3 block of node a:
 //   K_aa = A t [ (beta_a^T S+ beta_a) I + mu |beta_a|^2 F F^T + (mu + lambda) (F beta_a)(F
 //   beta_a)^T ].
+// With wrinkling (tension_field.hpp) S is replaced by the relaxed S*, which is never
+// compressive (S+ = S*), and psi by psi*. Where wrinkled, the material part of the blocks is
+//   A t [ (k - lambda^2 / k) v_a v_b^T + 4 mu r u_a u_b^T ],
+//   v_a = (beta_a . p) F p,  u_a = ((beta_a . m) F p + (beta_a . p) F m) / 2,
+// from dE_pp = sum_b v_b . dx_b and dE_pm = sum_b u_b . dx_b; slack elements have none. The
+// Hessian is then exact in all three regimes.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
+
+#include "conform/membrane/detail/tension_field.hpp"
 
 namespace conform::membrane::detail {
 
@@ -81,35 +89,66 @@ struct ElementState {
   Mat32 p;                 // first Piola-Kirchhoff stress F S (for the gradient)
   Eigen::Matrix2d stress;  // second Piola-Kirchhoff stress S
   double psi = 0;          // energy density, J/m^2
-  Eigen::Matrix2d s_pos;   // S+ (for the Hessian; add_hessian_terms)
-  Eigen::Matrix3d ff;      // F F^T (shared by the element's nine Hessian blocks; ditto)
+  Regime regime = Regime::taut;
+  Eigen::Vector2d dir_p, dir_m;  // wrinkled: tension and compression directions (rest frame)
+  double turn_ratio = 0;         // wrinkled: r
+  Eigen::Matrix2d s_pos;         // S+ (for the Hessian; add_hessian_terms)
+  Eigen::Matrix3d ff;            // F F^T (shared by the element's nine Hessian blocks; ditto)
+  Eigen::Vector3d fp, fm;        // wrinkled: F p, F m (ditto)
 };
 
-/// F, S, P and psi: what the energy and the gradient need.
+/// F, S, P and psi: what the energy and the gradient need; relaxed when `wrinkling`.
 inline ElementState element_forces(const ElementRest& e, const Eigen::Vector3d& x0,
                                    const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
-                                   double lambda, double mu) {
+                                   double lambda, double mu, bool wrinkling) {
   ElementState s;
   s.f = deformation_gradient(e, x0, x1, x2);
   const Eigen::Matrix2d strain = green_strain(s.f);
   s.stress = pk2_stress(e, strain, lambda, mu);
   s.psi = energy_density(e, strain, lambda, mu);
+  if (wrinkling) {
+    const Relaxation r = relax_compression(s.stress, lambda, mu);
+    s.regime = r.regime;
+    s.stress = r.stress;
+    s.psi -= r.energy_drop;
+    s.dir_p = r.p;
+    s.dir_m = r.m;
+    s.turn_ratio = r.turn_ratio;
+  }
   s.p = s.f * s.stress;
   return s;
 }
 
-/// S+ and F F^T from F and S: what the Hessian blocks need besides them.
+/// S+, F F^T (and F p, F m where wrinkled) from F and S: what the Hessian blocks need.
 inline void add_hessian_terms(ElementState& s) {
   s.s_pos = positive_part(s.stress);
   s.ff = s.f * s.f.transpose();
+  if (s.regime == Regime::wrinkled) {
+    s.fp = s.f * s.dir_p;
+    s.fm = s.f * s.dir_m;
+  }
 }
 
 inline ElementState element_state(const ElementRest& e, const Eigen::Vector3d& x0,
                                   const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
-                                  double lambda, double mu) {
-  ElementState s = element_forces(e, x0, x1, x2, lambda, mu);
+                                  double lambda, double mu, bool wrinkling) {
+  ElementState s = element_forces(e, x0, x1, x2, lambda, mu, wrinkling);
   add_hessian_terms(s);
   return s;
+}
+
+/// Wrinkled material terms of corner a: v_a, u_a (see the header), and the coefficients
+/// (k - lambda^2 / k) and 4 mu r.
+struct WrinkledCorner {
+  Eigen::Vector3d v, u;
+};
+inline WrinkledCorner wrinkled_corner(const ElementState& s, const Eigen::Vector2d& beta) {
+  const double bp = beta.dot(s.dir_p), bm = beta.dot(s.dir_m);
+  return {bp * s.fp, 0.5 * (bm * s.fp + bp * s.fm)};
+}
+inline double uniaxial_modulus(double lambda, double mu) {
+  const double k = lambda + 2 * mu;
+  return k - lambda * lambda / k;
 }
 
 /// Hessian approximation times (dx0, dx1, dx2): the three 3-vectors written to out0..out2.
@@ -121,23 +160,46 @@ inline void hessian_apply(const ElementRest& e, const ElementState& s, double la
   ds.col(0) = d1 - d0;
   ds.col(1) = d2 - d0;
   const Mat32 df = ds * e.beta.transpose();
-  const Eigen::Matrix2d m = s.f.transpose() * df;
-  const Eigen::Matrix2d de = 0.5 * (m + m.transpose());
-  const Eigen::Matrix2d dstress = lambda * de.trace() * Eigen::Matrix2d::Identity() + 2 * mu * de;
-  const Mat32 dp = e.area_thickness * (df * s.s_pos + s.f * dstress);
+  if (s.regime == Regime::taut) {
+    const Eigen::Matrix2d m = s.f.transpose() * df;
+    const Eigen::Matrix2d de = 0.5 * (m + m.transpose());
+    const Eigen::Matrix2d dstress = lambda * de.trace() * Eigen::Matrix2d::Identity() + 2 * mu * de;
+    const Mat32 dp = e.area_thickness * (df * s.s_pos + s.f * dstress);
+    out1 = dp * e.beta.col(0);
+    out2 = dp * e.beta.col(1);
+    out0 = -out1 - out2;
+    return;
+  }
+  const Mat32 dp = e.area_thickness * df * s.s_pos;  // geometric part (S+ = S*)
   out1 = dp * e.beta.col(0);
   out2 = dp * e.beta.col(1);
   out0 = -out1 - out2;
+  if (s.regime == Regime::slack) return;
+  const WrinkledCorner w[3] = {wrinkled_corner(s, beta_of(e, 0)), wrinkled_corner(s, beta_of(e, 1)),
+                               wrinkled_corner(s, beta_of(e, 2))};
+  const double de_pp = w[0].v.dot(d0) + w[1].v.dot(d1) + w[2].v.dot(d2);
+  const double de_pm = w[0].u.dot(d0) + w[1].u.dot(d1) + w[2].u.dot(d2);
+  const double cv = e.area_thickness * uniaxial_modulus(lambda, mu) * de_pp,
+               cu = e.area_thickness * 4 * mu * s.turn_ratio * de_pm;
+  out0 += cv * w[0].v + cu * w[0].u;
+  out1 += cv * w[1].v + cu * w[1].u;
+  out2 += cv * w[2].v + cu * w[2].u;
 }
 
 /// Block (a, b) of the Hessian approximation (corners a, b in 0..2).
 inline Eigen::Matrix3d hessian_block(const ElementRest& e, const ElementState& s, double lambda,
                                      double mu, int a, int b) {
   const Eigen::Vector2d ba = beta_of(e, a), bb = beta_of(e, b);
+  const Eigen::Matrix3d geometric = ba.dot(s.s_pos * bb) * Eigen::Matrix3d::Identity();
+  if (s.regime == Regime::slack) return e.area_thickness * geometric;
+  if (s.regime == Regime::wrinkled) {
+    const WrinkledCorner wa = wrinkled_corner(s, ba), wb = wrinkled_corner(s, bb);
+    return e.area_thickness * (geometric + uniaxial_modulus(lambda, mu) * wa.v * wb.v.transpose() +
+                               4 * mu * s.turn_ratio * wa.u * wb.u.transpose());
+  }
   const Eigen::Vector3d fa = s.f * ba, fb = s.f * bb;
-  return e.area_thickness *
-         ((ba.dot(s.s_pos * bb)) * Eigen::Matrix3d::Identity() + mu * ba.dot(bb) * s.ff +
-          mu * fb * fa.transpose() + lambda * fa * fb.transpose());
+  return e.area_thickness * (geometric + mu * ba.dot(bb) * s.ff + mu * fb * fa.transpose() +
+                             lambda * fa * fb.transpose());
 }
 
 /// The element's six distinct blocks K_ab, a <= b, in the order (0,0), (0,1), (0,2), (1,1),
@@ -145,6 +207,12 @@ inline Eigen::Matrix3d hessian_block(const ElementRest& e, const ElementState& s
 /// others are K_ba = K_ab^T, since S+ and F F^T are symmetric.
 inline void hessian_upper_blocks(const ElementRest& e, const ElementState& s, double lambda,
                                  double mu, Eigen::Matrix3d* out) {
+  if (s.regime != Regime::taut) {  // the rare relaxed elements: block by block
+    int k = 0;
+    for (int a = 0; a < 3; ++a)
+      for (int b = a; b < 3; ++b, ++k) out[k] = hessian_block(e, s, lambda, mu, a, b);
+    return;
+  }
   Eigen::Vector2d beta[3];
   Eigen::Vector3d f[3];
   for (int a = 0; a < 3; ++a) {
