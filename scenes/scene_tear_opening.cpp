@@ -34,7 +34,7 @@ constexpr const char* kTearOpeningJson = R"json({
   "seed": 1,
   "duration": 3.0,
   "model": { "resolution": 1 },
-  "pose": { "elbow_deg": 0, "flex_deg": 90, "flex_at": 1.5, "flex_duration": 0.5 },
+  "pose": { "elbow_deg": 0, "flex_deg": 0, "flex_at": 1.5, "flex_duration": 0.5 },
   "material": {
     "model": "membrane",
     "youngs_modulus": 420000, "poisson_ratio": 0.48, "thickness": 0.0015, "areal_density": 1.65,
@@ -71,7 +71,7 @@ class TearOpening final : public Scene {
     // The stroke is in world space: with a flexed elbow, move it with the forearm.
     elbow_deg_ = pose.number("elbow_deg", 0, 0, 150);
     // After the stroke the elbow may flex: the physical wound follows the pose.
-    flex_deg_ = pose.number("flex_deg", 90, -150, 150);
+    flex_deg_ = pose.number("flex_deg", 0, -150, 150);
     flex_at_ = pose.number("flex_at", 1.5, 0, 1e5);
     flex_duration_ = pose.number("flex_duration", 0.5, 1e-3, 1e5);
     if (elbow_deg_ + flex_deg_ < 0 || elbow_deg_ + flex_deg_ > 150)

@@ -78,7 +78,7 @@ TEST(SceneArmTrack, GravityCompensationAloneHoldsAnUnpoweredArm) {
 }
 
 TEST(SceneTearOpening, OpensByPhysicsUnderPrestressOnly) {
-  const Json s = run("tear-opening", "--set duration=2", "tear");
+  const Json s = run("tear-opening", "--set duration=2 --set pose.flex_deg=90", "tear");
   ASSERT_TRUE(s.is_object());
   const Json& m = s["metrics"];
   EXPECT_GT(m["physics"]["tear_points"].get<int>(), 20);

@@ -39,10 +39,11 @@ struct Relaxation {
 /// The relaxed stress and energy of a plane-stress StVK stress S (symmetric 2 x 2).
 inline Relaxation relax_compression(const Eigen::Matrix2d& s, double lambda, double mu) {
   const double a = s(0, 0), b = 0.5 * (s(0, 1) + s(1, 0)), c = s(1, 1);
-  const double mean = 0.5 * (a + c), radius = std::hypot(0.5 * (a - c), b);
-  const double s1 = mean + radius, s2 = mean - radius;
   Relaxation r;
   r.stress = s;
+  if (a >= 0 && c >= 0 && a * c >= b * b) return r;  // positive semi-definite: taut
+  const double mean = 0.5 * (a + c), radius = std::sqrt(0.25 * (a - c) * (a - c) + b * b);
+  const double s1 = mean + radius, s2 = mean - radius;
   if (s2 >= 0) return r;
   const double k = lambda + 2 * mu, sigma = s1 - lambda * s2 / k;
   if (sigma < 0) {
