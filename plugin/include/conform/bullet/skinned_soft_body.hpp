@@ -280,6 +280,11 @@ class SkinnedSoftBody {
   /// Changes mirrored since construction: +1 per TopologyChange (a drill or tear step may
   /// apply several). Face and vertex indices of mesh() may be reshuffled whenever it changes.
   std::uint64_t topology_version() const;
+  /// Per face of mesh(): skin, cap or tube wall, and the change that made it (op n: the n-th
+  /// TopologyChange applied to the mesh, as mesh().edits counts them; equal to
+  /// topology_version() at that change for a mesh given without edits; 0: the model's face).
+  /// Tags follow their faces through every edit and split into pieces (skinned_mesh.hpp).
+  std::span<const mesh::FaceTag> face_tags() const;
   /// Per vertex, the unit area-weighted normal of its faces at the simulated positions (zero
   /// for a vertex without faces); #V by 3 columns as mesh().current.
   Eigen::Matrix3Xd normals() const;
