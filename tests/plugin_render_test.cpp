@@ -1,6 +1,7 @@
 // Render data on a live body: a change counter that moves with every mirrored change, current
 // normals (outward on the arm), the pose and joint transforms of the last substep (checked
-// against the geometry of a bent shoulder), and the debug drawing through Bullet's own
+// against the geometry of a bent shoulder), per-face tags through splits, and the debug drawing
+// (skeleton, targets, tear path, blade) through Bullet's own
 // debugDrawWorld, counted by a test btIDebugDraw.
 #include <LinearMath/btIDebugDraw.h>
 #include <gtest/gtest.h>
@@ -13,6 +14,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "conform/bullet/convert.hpp"
 #include "conform/bullet/plugin.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
@@ -25,12 +27,17 @@ namespace {
 
 struct CountingDraw : btIDebugDraw {
   int mode = DBG_DrawWireframe;
-  int skeleton = 0, offsets = 0, other = 0;
-  void drawLine(const btVector3&, const btVector3&, const btVector3& color) override {
+  int skeleton = 0, offsets = 0, tear = 0, blade = 0, other = 0;
+  btVector3 blade_from{0, 0, 0}, blade_to{0, 0, 0};
+  void drawLine(const btVector3& from, const btVector3& to, const btVector3& color) override {
     if (color == btVector3(1, 1, 0))
       ++skeleton;
     else if (color == btVector3(0, 1, 1))
       ++offsets;
+    else if (color == btVector3(1, btScalar(0.5), 0))
+      ++tear;
+    else if (color == btVector3(1, 0, 1))
+      ++blade, blade_from = from, blade_to = to;
     else
       ++other;
   }
@@ -169,6 +176,40 @@ TEST(PluginRender, CounterNormalsPoseAndDebugDraw) {
   CountingDraw after;
   body.debug_draw(after);
   EXPECT_EQ(after.offsets, nodes - released_nodes);
+}
+
+TEST(PluginRender, DebugDrawShowsTheTearPathAndTheBlade) {
+  SoftWorld world;
+  bullet::Plugin plugin(world.world);
+  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
+  CountingDraw none;
+  body.debug_draw(none);
+  EXPECT_EQ(none.tear + none.blade, 0);  // no tear yet
+  body.begin_tear();
+  int extended = 0;
+  for (int i = 0; i <= 12; ++i) {
+    const double z = 0.08 + 0.006 * i;
+    extended += body.tear_advance({double(i), {0, 0, z}, {0.15, 0, z}}).extended;
+    world.step(1);
+  }
+  ASSERT_GE(extended, 2) << body.tear()->message();
+  CountingDraw draw;
+  world.world.setDebugDrawer(&draw);
+  world.world.debugDrawWorld();
+  world.world.setDebugDrawer(nullptr);
+  // One line per edge of each border, and the last sample's blade where it was.
+  const auto left = body.tear()->left_border(), right = body.tear()->right_border();
+  ASSERT_GE(left.size(), 2u);
+  EXPECT_EQ(draw.tear, int(left.size() + right.size()) - 2);
+  EXPECT_EQ(draw.blade, 1);
+  const double z = 0.08 + 0.006 * 12;
+  EXPECT_NEAR((bullet::from_bt(draw.blade_from) - cga::Vec3<double>(0, 0, z)).norm(), 0, 1e-6);
+  EXPECT_NEAR((bullet::from_bt(draw.blade_to) - cga::Vec3<double>(0.15, 0, z)).norm(), 0, 1e-6);
+  body.begin_tear();  // a new tear: nothing to draw until its first sample
+  CountingDraw fresh;
+  body.debug_draw(fresh);
+  EXPECT_EQ(fresh.tear + fresh.blade, 0);
 }
 
 TEST(PluginRender, ClockAndSnapToTheFirstPose) {

@@ -219,6 +219,7 @@ mesh::DrillResult SkinnedSoftBody::Impl::drill(const mesh::DrillTool& tool,
 void SkinnedSoftBody::Impl::begin_tear(const mesh::TearOptions& options) {
   check_editable("begin_tear");
   tear_ = std::make_unique<mesh::Tear>(mesh_, adjacency_, face_index_, options);
+  blade_.reset();
 }
 
 mesh::TearStep SkinnedSoftBody::Impl::tear_advance(const mesh::ScalpelSample& sample) {
@@ -229,6 +230,7 @@ mesh::TearStep SkinnedSoftBody::Impl::tear_advance(const mesh::ScalpelSample& sa
   sync_mesh();
   stats_.seconds.sync = seconds_since(clock);
   mesh::TearStep step = tear_->advance(sample);
+  blade_ = sample;  // drawn by debug_draw
   stats_.seconds.mesh = seconds_since(clock);
   for (const auto& change : step.changes) mirror(change);
   drive_.extend(mesh_);
