@@ -65,6 +65,7 @@ else
 fi
 cmake -S "$work/right" -B "$work/right/build" -DCMAKE_PREFIX_PATH="$work/prefix" >"$work/right.log" 2>&1 ||
   { cat "$work/right.log"; fail "a project of the package's Bullet precision was refused"; }
+echo "install_test: a project of $wrong-precision Bullet is refused at configure time, one of $mine configures"
 
 cmake -S "$source_dir/tests/consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" \
   -DCMAKE_BUILD_TYPE=Release -DCMAKE_EXPORT_COMPILE_COMMANDS=ON >/dev/null
