@@ -4,7 +4,8 @@
 # Bullet consumer (conform::core, conform::bullet) compiles without -fopenmp or any Conform
 # definition and links no assimp; the importer (conform::io) links assimp and reads a model;
 # no internal or detail/ header (other than cga's, which multivector.hpp needs) is installed;
-# the application (tests/consumer/application.cpp) runs, also built with ASan and UBSan.
+# the application (tests/consumer/application.cpp) runs, also built with ASan and UBSan; a
+# project of the other Bullet precision fails at configure time with a message.
 # Arguments: <conform binary> <source dir> <build dir>.
 set -euo pipefail
 source_dir="$2"
@@ -27,6 +28,44 @@ done
 details="$(cd "$include" && find . -path '*/detail/*' ! -path './cga/detail/product_table.hpp' \
   ! -path './membrane/detail/cst_kernel.hpp' ! -path './membrane/detail/tension_field.hpp')"
 [[ -z "$details" ]] || fail "detail headers are installed: $details"
+
+# A project of the other Bullet precision is refused at configure time, with a message that
+# says so; the same project with the package's precision configures.
+precision_project() { # <dir> <line before find_package(Conform)>
+  mkdir -p "$1"
+  printf 'cmake_minimum_required(VERSION 3.25)\nproject(precision LANGUAGES CXX)\n%s\n%s\n' \
+    "$2" 'find_package(Conform REQUIRED)' >"$1/CMakeLists.txt"
+}
+expect_precision_refused() { # <dir> <what the message must name> [cmake arguments]
+  local dir="$1" source="$2"
+  shift 2
+  if cmake -S "$dir" -B "$dir/build" -DCMAKE_PREFIX_PATH="$work/prefix" "$@" >"$dir/log" 2>&1; then
+    fail "a project using $wrong-precision Bullet ($source) configured against the $mine package"
+  fi
+  local said
+  said="$(tr -s ' \n' '  ' <"$dir/log")"
+  grep -qF "built against $mine-precision Bullet, but this project uses $wrong-precision Bullet ($source" \
+    <<<"$said" || { cat "$dir/log"; fail "the precision mismatch was refused without its message"; }
+}
+if [[ "$double" == ON ]]; then
+  mine=double wrong=float
+  precision_project "$work/wrong-find" 'find_package(Bullet REQUIRED CONFIG CONFIGS BulletConfig.cmake)'
+  expect_precision_refused "$work/wrong-find" "its find_package(Bullet)"
+  precision_project "$work/right" 'find_package(Bullet REQUIRED CONFIG CONFIGS BulletConfig-float64.cmake)'
+else
+  mine=float wrong=double
+  precision_project "$work/wrong-flags" ''
+  expect_precision_refused "$work/wrong-flags" "BT_USE_DOUBLE_PRECISION in CMAKE_CXX_FLAGS" \
+    -DCMAKE_CXX_FLAGS=-DBT_USE_DOUBLE_PRECISION
+  precision_project "$work/wrong-definition" 'add_compile_definitions(BT_USE_DOUBLE_PRECISION)'
+  expect_precision_refused "$work/wrong-definition" "BT_USE_DOUBLE_PRECISION in the directory"
+  precision_project "$work/wrong-find" 'find_package(Bullet REQUIRED CONFIG CONFIGS BulletConfig-float64.cmake)'
+  expect_precision_refused "$work/wrong-find" "its find_package(Bullet)"
+  precision_project "$work/right" 'find_package(Bullet REQUIRED CONFIG CONFIGS BulletConfig.cmake)'
+fi
+cmake -S "$work/right" -B "$work/right/build" -DCMAKE_PREFIX_PATH="$work/prefix" >"$work/right.log" 2>&1 ||
+  { cat "$work/right.log"; fail "a project of the package's Bullet precision was refused"; }
+echo "install_test: a project of $wrong-precision Bullet is refused at configure time, one of $mine configures"
 
 cmake -S "$source_dir/tests/consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" \
   -DCMAKE_BUILD_TYPE=Release -DCMAKE_EXPORT_COMPILE_COMMANDS=ON >/dev/null

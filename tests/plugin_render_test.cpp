@@ -1,15 +1,20 @@
 // Render data on a live body: a change counter that moves with every mirrored change, current
 // normals (outward on the arm), the pose and joint transforms of the last substep (checked
-// against the geometry of a bent shoulder), and the debug drawing through Bullet's own
+// against the geometry of a bent shoulder), per-face tags through splits, and the debug drawing
+// (skeleton, targets, tear path, blade) through Bullet's own
 // debugDrawWorld, counted by a test btIDebugDraw.
 #include <LinearMath/btIDebugDraw.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <set>
 #include <stdexcept>
 
+#include "conform/bullet/convert.hpp"
 #include "conform/bullet/plugin.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
@@ -22,12 +27,17 @@ namespace {
 
 struct CountingDraw : btIDebugDraw {
   int mode = DBG_DrawWireframe;
-  int skeleton = 0, offsets = 0, other = 0;
-  void drawLine(const btVector3&, const btVector3&, const btVector3& color) override {
+  int skeleton = 0, offsets = 0, tear = 0, blade = 0, other = 0;
+  btVector3 blade_from{0, 0, 0}, blade_to{0, 0, 0};
+  void drawLine(const btVector3& from, const btVector3& to, const btVector3& color) override {
     if (color == btVector3(1, 1, 0))
       ++skeleton;
     else if (color == btVector3(0, 1, 1))
       ++offsets;
+    else if (color == btVector3(1, btScalar(0.5), 0))
+      ++tear;
+    else if (color == btVector3(1, 0, 1))
+      ++blade, blade_from = from, blade_to = to;
     else
       ++other;
   }
@@ -39,7 +49,79 @@ struct CountingDraw : btIDebugDraw {
   int getDebugMode() const override { return mode; }
 };
 
+// The face lies in the plane: every corner within 1e-9 of it. (The cuts of these tests do
+// not snap, kCutExactly: a vertex the cut snaps is taken as on the plane without moving.)
+bool in_plane(const mesh::SkinnedMesh& m, const mesh::Face& f, const cga::Plane<double>& p) {
+  for (auto v : f)
+    if (std::abs(p.signed_distance(m.current.col(v))) > 1e-9) return false;
+  return true;
+}
+
+const mesh::CutOptions kCutExactly{.snap_fraction = 0, .min_angle = 0, .cap = true};
+
+std::array<std::int32_t, 3> sorted(mesh::Face f) {
+  std::sort(f.begin(), f.end());
+  return f;
+}
+
 }  // namespace
+
+TEST(PluginRender, FaceTagsFollowTheirFacesThroughSplitsAndEdits) {
+  SoftWorld world;
+  bullet::Plugin plugin(world.world);
+  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
+  ASSERT_EQ(body.face_tags().size(), arm.mesh.faces.size());
+  for (const auto& tag : body.face_tags()) EXPECT_EQ(tag, mesh::FaceTag{});
+  world.step(2);
+
+  // A capped cut through the forearm: the faces in its plane, and only they, are cap, with
+  // the change's op; each side's cap is in its own piece.
+  const auto forearm = cga::Plane<double>::from_normal_point({0, 0, 1}, {0, 0, 0.42});
+  const mesh::CutResult first = body.cut(forearm, kCutExactly);
+  ASSERT_EQ(first.capped_loops, 1) << first.message;
+  ASSERT_EQ(body.piece_count(), 2);
+  const std::uint32_t first_op = static_cast<std::uint32_t>(body.topology_version());
+  std::map<std::array<std::int32_t, 3>, mesh::FaceTag> caps;
+  std::set<std::int32_t> cap_pieces;  // piece slots
+  for (std::int32_t f = 0; f < body.mesh().face_count(); ++f) {
+    const mesh::Face& face = body.mesh().faces[std::size_t(f)];
+    const mesh::FaceTag tag = body.face_tags()[std::size_t(f)];
+    ASSERT_EQ(tag.kind == mesh::FaceKind::cap, in_plane(body.mesh(), face, forearm)) << f;
+    if (tag.kind != mesh::FaceKind::cap) continue;
+    EXPECT_EQ(tag.op, first_op);
+    caps[sorted(face)] = tag;
+    cap_pieces.insert(body.piece_of(face[0]).index);
+  }
+  EXPECT_EQ(caps.size(), std::size_t(2 * first.cap_faces));
+  EXPECT_EQ(cap_pieces.size(), 2u);
+
+  // A second capped cut, through the upper arm, splits again and reshuffles the face slots:
+  // the first caps are all still there with their tags, the new caps lie in the second plane.
+  world.step(3);
+  const auto upper = cga::Plane<double>::from_normal_point({0, 0, 1}, {0, 0, 0.15});
+  const mesh::CutResult second = body.cut(upper, kCutExactly);
+  ASSERT_EQ(second.capped_loops, 1) << second.message;
+  ASSERT_EQ(body.piece_count(), 3);
+  const auto second_op = static_cast<std::uint32_t>(body.topology_version());
+  ASSERT_GT(second_op, first_op);
+  std::size_t kept = 0;
+  std::int32_t new_caps = 0;
+  for (std::int32_t f = 0; f < body.mesh().face_count(); ++f) {
+    const mesh::Face& face = body.mesh().faces[std::size_t(f)];
+    const mesh::FaceTag tag = body.face_tags()[std::size_t(f)];
+    if (const auto it = caps.find(sorted(face)); it != caps.end()) {
+      EXPECT_EQ(tag, it->second) << f;
+      ++kept;
+    } else if (tag.kind == mesh::FaceKind::cap) {
+      EXPECT_EQ(tag.op, second_op) << f;
+      EXPECT_TRUE(in_plane(body.mesh(), face, upper)) << f;
+      ++new_caps;
+    }
+  }
+  EXPECT_EQ(kept, caps.size());
+  EXPECT_EQ(new_caps, 2 * second.cap_faces);
+}
 
 TEST(PluginRender, CounterNormalsPoseAndDebugDraw) {
   SoftWorld world;
@@ -94,6 +176,40 @@ TEST(PluginRender, CounterNormalsPoseAndDebugDraw) {
   CountingDraw after;
   body.debug_draw(after);
   EXPECT_EQ(after.offsets, nodes - released_nodes);
+}
+
+TEST(PluginRender, DebugDrawShowsTheTearPathAndTheBlade) {
+  SoftWorld world;
+  bullet::Plugin plugin(world.world);
+  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
+  CountingDraw none;
+  body.debug_draw(none);
+  EXPECT_EQ(none.tear + none.blade, 0);  // no tear yet
+  body.begin_tear();
+  int extended = 0;
+  for (int i = 0; i <= 12; ++i) {
+    const double z = 0.08 + 0.006 * i;
+    extended += body.tear_advance({double(i), {0, 0, z}, {0.15, 0, z}}).extended;
+    world.step(1);
+  }
+  ASSERT_GE(extended, 2) << body.tear()->message();
+  CountingDraw draw;
+  world.world.setDebugDrawer(&draw);
+  world.world.debugDrawWorld();
+  world.world.setDebugDrawer(nullptr);
+  // One line per edge of each border, and the last sample's blade where it was.
+  const auto left = body.tear()->left_border(), right = body.tear()->right_border();
+  ASSERT_GE(left.size(), 2u);
+  EXPECT_EQ(draw.tear, int(left.size() + right.size()) - 2);
+  EXPECT_EQ(draw.blade, 1);
+  const double z = 0.08 + 0.006 * 12;
+  EXPECT_NEAR((bullet::from_bt(draw.blade_from) - cga::Vec3<double>(0, 0, z)).norm(), 0, 1e-6);
+  EXPECT_NEAR((bullet::from_bt(draw.blade_to) - cga::Vec3<double>(0.15, 0, z)).norm(), 0, 1e-6);
+  body.begin_tear();  // a new tear: nothing to draw until its first sample
+  CountingDraw fresh;
+  body.debug_draw(fresh);
+  EXPECT_EQ(fresh.tear + fresh.blade, 0);
 }
 
 TEST(PluginRender, ClockAndSnapToTheFirstPose) {

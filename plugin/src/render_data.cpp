@@ -1,6 +1,6 @@
 // What an application reads to display a skinned body: current normals, the pose and joint
-// transforms, and the debug drawing of what Bullet does not draw itself (the skeleton and the
-// pull of every driven node toward its skinned target).
+// transforms, and the debug drawing of what Bullet does not draw itself (the skeleton, the
+// pull of every driven node toward its skinned target, the tear's path and its blade).
 #include <LinearMath/btIDebugDraw.h>
 
 #include <vector>
@@ -42,6 +42,14 @@ void SkinnedSoftBody::Impl::debug_draw(btIDebugDraw& drawer) const {
     if (parent >= 0)
       drawer.drawLine(origin(global[static_cast<std::size_t>(parent)]), origin(global[j]), yellow);
   }
+  if (tear_ && tear_->started()) {
+    // Both borders of the tear (they share its start and tip), at the simulated positions.
+    const btVector3 orange(1, 0.5, 0);
+    for (const auto& border : {tear_->left_border(), tear_->right_border()})
+      for (std::size_t i = 1; i < border.size(); ++i)
+        drawer.drawLine(to_bt(position(border[i - 1])), to_bt(position(border[i])), orange);
+  }
+  if (blade_) drawer.drawLine(to_bt(blade_->a), to_bt(blade_->b), btVector3(1, 0, 1));
   for (const auto& piece : pieces_) {
     if (!piece || !piece->body || piece->released) continue;
     const btSoftBody& body = *piece->body;

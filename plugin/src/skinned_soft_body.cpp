@@ -34,6 +34,10 @@ void validate(const mesh::SkinnedMesh& mesh, const skin::Skeleton& skeleton) {
                                 std::to_string(mesh.weights.cols()) +
                                 " weight columns (need one per vertex)");
   if (skeleton.bone_count() == 0) throw std::invalid_argument("SkinnedSoftBody: no bones");
+  if (!mesh.face_tags.empty() && !mesh.has_face_tags())
+    throw std::invalid_argument("SkinnedSoftBody: " + std::to_string(mesh.face_tags.size()) +
+                                " face tags for " + std::to_string(mesh.faces.size()) +
+                                " faces (need one per face, or none)");
   for (std::size_t f = 0; f < mesh.faces.size(); ++f)
     for (const auto v : mesh.faces[f])
       if (v < 0 || v >= n)
@@ -130,6 +134,7 @@ SkinnedSoftBody::Impl::Impl(const WorldLink& link, const mesh::SkinnedMesh& mesh
         "SkinnedSoftBody: the world link lacks its world info, add or remove");
   validate(mesh_, skeleton_);
   validate(material_);
+  mesh_.face_tags.resize(mesh_.faces.size());  // a mesh without tags: all skin, from the model
   if (membrane_model()) material_.density = material_.skin.areal_density;  // the books' masses
   adjacency_.build(mesh_);
   face_index_.build(mesh_);
@@ -214,6 +219,7 @@ mesh::DrillResult SkinnedSoftBody::Impl::drill(const mesh::DrillTool& tool,
 void SkinnedSoftBody::Impl::begin_tear(const mesh::TearOptions& options) {
   check_editable("begin_tear");
   tear_ = std::make_unique<mesh::Tear>(mesh_, adjacency_, face_index_, options);
+  blade_.reset();
 }
 
 mesh::TearStep SkinnedSoftBody::Impl::tear_advance(const mesh::ScalpelSample& sample) {
@@ -224,6 +230,7 @@ mesh::TearStep SkinnedSoftBody::Impl::tear_advance(const mesh::ScalpelSample& sa
   sync_mesh();
   stats_.seconds.sync = seconds_since(clock);
   mesh::TearStep step = tear_->advance(sample);
+  blade_ = sample;  // drawn by debug_draw
   stats_.seconds.mesh = seconds_since(clock);
   for (const auto& change : step.changes) mirror(change);
   drive_.extend(mesh_);
@@ -495,6 +502,9 @@ bool SkinnedSoftBody::piece_released(PieceId id) const {
 
 std::uint64_t SkinnedSoftBody::topology_version() const {
   return impl_->topology_version_;
+}
+std::span<const mesh::FaceTag> SkinnedSoftBody::face_tags() const {
+  return impl_->mesh_.face_tags;
 }
 Eigen::Matrix3Xd SkinnedSoftBody::normals() const {
   return impl_->normals();

@@ -267,8 +267,9 @@ struct SkinnedSoftBody::Impl {
   std::string lost_;                    // why the body is unusable (a piece deleted by the app)
   double time_ = 0;                     // of the last substep (targets after an edit)
   std::uint64_t topology_version_ = 0;  // changes mirrored
-  std::optional<Clock> clock_;          // the body's own animation clock, when set
-  double clock_now_ = 0;                // the time the pose source was last sampled at
+  std::optional<mesh::ScalpelSample> blade_;  // the last tear sample (debug drawing)
+  std::optional<Clock> clock_;                // the body's own animation clock, when set
+  double clock_now_ = 0;                      // the time the pose source was last sampled at
   ApplyStats stats_;
 };
 

@@ -3,8 +3,9 @@
 //   - its own btSoftRigidDynamicsWorld, a ground box and two dynamic rigid boxes;
 //   - a real rigged model (argv[1], read with conform::io) playing its animation;
 //   - the procedural arm driven by the closed-form CGA IK toward a moving target;
-//   - a second arm torn by a kinematic rigid-body scalpel (RigidScalpel), cut (capped), its
-//     hand released from skinning with its volume kept, landing on the ground box;
+//   - a second arm torn by a kinematic rigid-body scalpel (RigidScalpel), cut (capped, its cap
+//     faces tagged cap), its hand released from skinning with its volume kept, landing on the
+//     ground box;
 //   - a piece handle kept across the edit that empties its piece, and the events;
 //   - both teardown orders (Bullet's standard one, and the world destroyed first).
 // Every check prints what it measured; the exit code is non-zero if one fails.
@@ -181,6 +182,11 @@ void run(const std::string& model_file, bool world_first) {
         "capped cut of the forearm (loops)", cut.loops);
   check(std::abs(arm.total_mass() - arm_mass) < 1e-9 * arm_mass, "mass kept by tear and cut (kg)",
         arm.total_mass());
+  // The renderer's view of the cut: its cap faces (both sides) tagged cap, by this change.
+  std::int32_t cap_faces = 0;
+  for (const auto& tag : arm.face_tags())
+    cap_faces += tag.kind == conform::mesh::FaceKind::cap && tag.op == arm.mesh().edits;
+  check(cap_faces == 2 * cut.cap_faces, "face tags: the cut's cap faces (faces)", cap_faces);
   cb::PieceId hand{};
   for (std::int32_t v = 0; v < arm.vertex_count(); ++v)
     if (arm.position(v).z() > 0.6) hand = arm.piece_of(v);

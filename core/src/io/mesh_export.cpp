@@ -140,12 +140,13 @@ void add(std::string& out, double v, bool space = true) {
 struct Attributes {
   const mesh::SkinnedMesh& mesh;
   const Selection& s;
-  bool uvs, normals;
+  bool uvs, normals, tags;
   Attributes(const mesh::SkinnedMesh& m, const Selection& sel, const MeshExportOptions& o)
       : mesh(m),
         s(sel),
         uvs(o.uvs && (sel.uvs.cols() > 0 || m.has_uvs())),
-        normals(o.normals && sel.normals.cols() > 0) {}
+        normals(o.normals && sel.normals.cols() > 0),
+        tags(o.face_tags && m.has_face_tags()) {}
   double uv(std::size_t i, int k) const {
     return s.uvs.cols() > 0 ? s.uvs(k, Eigen::Index(i)) : mesh.uvs(k, s.vertices[i]);
   }
@@ -190,7 +191,9 @@ std::string encode_ply(const Eigen::Ref<const Eigen::Matrix3Xd>& pos, const Attr
   if (a.uvs) out += "property double s\nproperty double t\n";
   if (a.normals) out += "property double nx\nproperty double ny\nproperty double nz\n";
   out += "element face " + std::to_string(s.faces.size()) + "\n";
-  out += "property list uchar int vertex_indices\nend_header\n";
+  out += "property list uchar int vertex_indices\n";
+  if (a.tags) out += "property uchar surface\nproperty uint op\n";
+  out += "end_header\n";
   for (std::size_t i = 0; i < s.vertices.size(); ++i) {
     std::array<double, 8> values{};
     int n = 0;
@@ -201,14 +204,22 @@ std::string encode_ply(const Eigen::Ref<const Eigen::Matrix3Xd>& pos, const Attr
       binary ? put(out, values[std::size_t(k)]) : add(out, values[std::size_t(k)], k > 0);
     if (!binary) out += "\n";
   }
-  for (const auto& f : s.faces) {
+  for (std::size_t i = 0; i < s.faces.size(); ++i) {
+    const auto& f = s.faces[i];
+    const mesh::FaceTag tag = a.tags ? a.mesh.face_tag(s.face_ids[i]) : mesh::FaceTag{};
     if (binary) {
       put(out, static_cast<std::uint8_t>(3));
       for (auto v : f) put(out, static_cast<std::int32_t>(v));
+      if (a.tags) put(out, static_cast<std::uint8_t>(tag.kind)), put(out, tag.op);
     } else {
       // Appended piecewise: GCC 12 reports a false -Wrestrict on "3 " + std::string.
       out += "3";
       for (auto v : f) out.append(" ").append(std::to_string(v));
+      if (a.tags)
+        out.append(" ")
+            .append(std::to_string(static_cast<int>(tag.kind)))
+            .append(" ")
+            .append(std::to_string(tag.op));
       out += "\n";
     }
   }

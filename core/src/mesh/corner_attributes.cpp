@@ -201,4 +201,12 @@ AddedCorners added_corner_attributes(const SkinnedMesh& mesh, const TopologyChan
   return out;
 }
 
+std::vector<std::int32_t> added_face_origins(const SkinnedMesh& mesh,
+                                             const TopologyChange& change) {
+  const OriginSearch search(mesh, change);
+  std::vector<std::int32_t> origin(change.added_faces.size());
+  for (std::size_t i = 0; i < origin.size(); ++i) origin[i] = search.origin(change.added_faces[i]);
+  return origin;
+}
+
 }  // namespace conform::mesh

@@ -843,6 +843,7 @@ class CutComputation {
     for (auto d : section.depth) result_.nested_loops += d > 0;
     TopologyChange& ch = result_.change;
     ch.added_faces.reserve(ch.added_faces.size() + 2 * section.triangles.size());
+    const auto first = static_cast<std::int32_t>(ch.added_faces.size());
     for (const auto& t : section.triangles) {
       Face plus, minus;
       for (int k = 0; k < 3; ++k) {
@@ -861,6 +862,8 @@ class CutComputation {
       }
       ++result_.cap_faces;
     }
+    const auto count = static_cast<std::int32_t>(ch.added_faces.size()) - first;
+    if (count > 0) ch.new_surface.push_back({first, count, FaceKind::cap});
   }
 
   const SkinnedMesh& mesh_;

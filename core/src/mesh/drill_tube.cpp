@@ -44,6 +44,9 @@ class TubeBuilder {
       i += 2;
       join(pa, pb);
     }
+    if (!faces_.empty())
+      change_.new_surface.push_back({static_cast<std::int32_t>(change_.added_faces.size()),
+                                     static_cast<std::int32_t>(faces_.size()), FaceKind::tube});
     change_.added_faces.insert(change_.added_faces.end(), faces_.begin(), faces_.end());
   }
 

@@ -46,6 +46,15 @@ std::string TopologyChange::validate() const {
       if (v < 0 || v >= nv) return "added face refers to a vertex out of range";
     if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) return "added face repeats a vertex";
   }
+  std::int64_t covered = 0;  // added faces before the next run may start
+  for (const NewSurface& run : new_surface) {
+    if (run.first < covered || run.count < 0 ||
+        std::int64_t(run.first) + run.count > std::int64_t(added_faces.size()))
+      return "new surface run out of range or overlapping";
+    if (run.kind != FaceKind::skin && run.kind != FaceKind::cap && run.kind != FaceKind::tube)
+      return "new surface of unknown kind";
+    covered = std::int64_t(run.first) + run.count;
+  }
   return {};
 }
 
@@ -110,6 +119,9 @@ void apply(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency
     throw std::invalid_argument("apply: the adjacency does not describe this mesh");
   if (const std::string problem = change.validate(); !problem.empty())
     throw std::invalid_argument("apply: " + problem);
+  if (!mesh.face_tags.empty() && mesh.face_tags.size() != mesh.faces.size())
+    throw std::invalid_argument("apply: the mesh has " + std::to_string(mesh.face_tags.size()) +
+                                " face tags for " + std::to_string(mesh.faces.size()) + " faces");
   detail::apply_vertices(mesh, change);
   detail::apply_faces(mesh, change, adjacency);
 }
@@ -159,10 +171,36 @@ void apply_vertices(SkinnedMesh& mesh, const TopologyChange& change) {
   }
 }
 
+// The tags of the added faces (skinned_mesh.hpp's rule): new surface as listed, every other
+// face the kind of its origin. The origin search only runs when a removed face is not skin
+// (otherwise every origin is skin); `origins` is the corner attributes' when they ran.
+static std::vector<FaceTag> added_face_tags(const SkinnedMesh& mesh, const TopologyChange& change,
+                                            const std::vector<std::int32_t>& origins) {
+  const FaceTag made{FaceKind::skin, mesh.edits + 1};
+  std::vector<FaceTag> tags(change.added_faces.size(), made);
+  const bool inherit = std::any_of(
+      change.removed_faces.begin(), change.removed_faces.end(),
+      [&](std::int32_t f) { return mesh.face_tags[std::size_t(f)].kind != FaceKind::skin; });
+  if (inherit) {
+    const std::vector<std::int32_t> searched =
+        origins.empty() ? added_face_origins(mesh, change) : std::vector<std::int32_t>{};
+    const std::vector<std::int32_t>& origin = origins.empty() ? searched : origins;
+    for (std::size_t k = 0; k < tags.size(); ++k)
+      if (origin[k] >= 0) tags[k].kind = mesh.face_tags[std::size_t(origin[k])].kind;
+  }
+  for (const NewSurface& run : change.new_surface)
+    for (std::int32_t k = run.first; k < run.first + run.count; ++k)
+      tags[std::size_t(k)].kind = run.kind;
+  return tags;
+}
+
 void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency) {
   const auto& added = change.added_faces;
-  // The added faces' corner attributes, computed while the removed faces are still there.
+  // The added faces' corner attributes and tags, computed while the removed faces are there.
   const AddedCorners corners = added_corner_attributes(mesh, change);
+  if (mesh.face_tags.size() != mesh.faces.size()) mesh.face_tags.assign(mesh.faces.size(), {});
+  const std::vector<FaceTag> tags = added_face_tags(mesh, change, corners.origin);
+  ++mesh.edits;
   const bool corner_uvs = mesh.has_corner_uvs(), corner_normals = mesh.has_corner_normals();
   if (adjacency)
     for (auto f : change.removed_faces) adjacency->remove_face(mesh, f);
@@ -173,6 +211,7 @@ void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adj
     const std::vector<Face>& added;
     std::size_t filled;
     const AddedCorners& corners;
+    const std::vector<FaceTag>& tags;
     bool uvs, normals;
     // The corner attributes follow their face through every slot operation.
     void set_corners(std::int32_t slot, std::size_t k) {
@@ -186,6 +225,7 @@ void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adj
     }
     void fill(std::int32_t slot, std::size_t k) {
       mesh.faces[static_cast<std::size_t>(slot)] = added[k];
+      mesh.face_tags[static_cast<std::size_t>(slot)] = tags[k];
       set_corners(slot, k);
       if (adjacency) adjacency->add_face(mesh, slot);
     }
@@ -198,24 +238,27 @@ void apply_faces(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adj
         adjacency->resize_faces(
             static_cast<std::int32_t>(mesh.faces.size() + (added.size() - filled)));
       mesh.faces.push_back(added[k]);
+      mesh.face_tags.push_back(tags[k]);
       resize_corners(mesh.face_count());
       set_corners(slot, k);
       if (adjacency) adjacency->add_face(mesh, slot);
     }
     void move(std::int32_t last, std::int32_t slot) {
       mesh.faces[static_cast<std::size_t>(slot)] = mesh.faces.back();
+      mesh.face_tags[static_cast<std::size_t>(slot)] = mesh.face_tags.back();
       if (uvs) mesh.corner_uvs.col(slot) = mesh.corner_uvs.col(last);
       if (normals) mesh.corner_normals.col(slot) = mesh.corner_normals.col(last);
       if (adjacency) adjacency->move_face(mesh, last, slot);
     }
     void pop(std::int32_t) {
       mesh.faces.pop_back();
+      mesh.face_tags.pop_back();
       resize_corners(mesh.face_count());
       if (adjacency) adjacency->resize_faces(mesh.face_count());
     }
   };
-  visit_face_slots(change,
-                   Slots{mesh, adjacency, added, filled, corners, corner_uvs, corner_normals});
+  visit_face_slots(
+      change, Slots{mesh, adjacency, added, filled, corners, tags, corner_uvs, corner_normals});
 }
 
 }  // namespace detail

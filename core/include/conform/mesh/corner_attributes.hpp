@@ -47,4 +47,8 @@ struct AddedCorners {
 };
 AddedCorners added_corner_attributes(const SkinnedMesh& mesh, const TopologyChange& change);
 
+/// Only the origins of AddedCorners (computed whether or not the mesh has corner attributes):
+/// per added face, the removed base face it lies in, or −1 for new surface.
+std::vector<std::int32_t> added_face_origins(const SkinnedMesh& mesh, const TopologyChange& change);
+
 }  // namespace conform::mesh

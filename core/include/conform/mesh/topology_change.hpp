@@ -20,6 +20,11 @@
 //   3. the remaining removed slots, from the highest down, are filled by moving the last face
 //      into them and popping it (swap-with-last; a slot that is the last face is just popped).
 // Faces not mentioned keep their index, except those moved in step 3.
+//
+// Face tags (skinned_mesh.hpp). `new_surface` lists the runs of added faces that are new
+// surface, with their kind: a cut's cap, a drill's tube wall. Every other added face keeps the
+// kind of the removed face it lies in (corner_attributes.hpp's origin; skin when none is
+// found). Every added face gets op = the mesh's edit count after the change.
 #pragma once
 
 #include <Eigen/Core>
@@ -50,12 +55,19 @@ struct NewVertex {
   bool is_duplicate() const { return parents[1] < 0; }
 };
 
+/// Added faces [first, first + count) are new surface of this kind.
+struct NewSurface {
+  std::int32_t first = 0, count = 0;
+  FaceKind kind = FaceKind::cap;
+};
+
 struct TopologyChange {
   std::int32_t base_vertex_count = 0;  // the mesh the change was computed for
   std::int32_t base_face_count = 0;
   std::vector<NewVertex> new_vertices;
   std::vector<std::int32_t> removed_faces;  // strictly increasing
   std::vector<Face> added_faces;
+  std::vector<NewSurface> new_surface;  // increasing, disjoint runs of added faces
 
   bool empty() const {
     return new_vertices.empty() && removed_faces.empty() && added_faces.empty();
@@ -67,9 +79,10 @@ struct TopologyChange {
   std::int32_t face_after(std::int32_t f) const;
 };
 
-/// Applies `change` to `mesh` (positions, skinning data, UVs, normals, faces) and, when given,
-/// keeps `adjacency` up to date. Throws std::invalid_argument (leaving both untouched) when the
-/// change does not validate or was computed for a mesh of other counts.
+/// Applies `change` to `mesh` (positions, skinning data, UVs, normals, faces, face tags; +1 to
+/// mesh.edits) and, when given, keeps `adjacency` up to date. Throws std::invalid_argument
+/// (leaving both untouched) when the change does not validate, was computed for a mesh of
+/// other counts, or the mesh's face_tags are neither empty nor one per face.
 void apply(SkinnedMesh& mesh, const TopologyChange& change, Adjacency* adjacency = nullptr);
 
 /// The face-slot rule (steps 1–3 above), written once for every copy of the faces that has to

@@ -21,7 +21,8 @@
 //
 // Threading: a plugin and its bodies are used from the thread that steps the world, between
 // stepSimulation calls (edits inside a step throw std::logic_error); distinct plugins on
-// distinct worlds may run on distinct threads.
+// distinct worlds may run on distinct threads. A body's const queries keep no caches: several
+// threads may read one body at once while nothing steps or edits it.
 #pragma once
 
 #include <functional>

@@ -10,6 +10,12 @@
 // material's, with its state at the edit (so that edits conserve both exactly), and from the
 // next substep on it rides its skinned target.
 //
+// Vertices are never reclaimed (a documented bound instead of compaction): the vertex arrays
+// grow by exactly the new vertices of each change, vertex indices never change after an edit
+// (face indices do, see topology_version()), and the only vertices left unused are the detached
+// insides of drilled holes, each costing its per-vertex arrays (a few hundred bytes) and its
+// skinning every substep, no Bullet work (tests: DetachedVerticesAreBoundedByTheHoles).
+//
 // Edits cost time proportional to the change: nodes, links and faces are removed by
 // swap-with-last with local re-pointing; link constants, rest lengths and face areas of what
 // changed are written here, so Bullet's whole-body reset (m_bUpdateRtCst) is never triggered;
@@ -280,6 +286,11 @@ class SkinnedSoftBody {
   /// Changes mirrored since construction: +1 per TopologyChange (a drill or tear step may
   /// apply several). Face and vertex indices of mesh() may be reshuffled whenever it changes.
   std::uint64_t topology_version() const;
+  /// Per face of mesh(): skin, cap or tube wall, and the change that made it (op n: the n-th
+  /// TopologyChange applied to the mesh, as mesh().edits counts them; equal to
+  /// topology_version() at that change for a mesh given without edits; 0: the model's face).
+  /// Tags follow their faces through every edit and split into pieces (skinned_mesh.hpp).
+  std::span<const mesh::FaceTag> face_tags() const;
   /// Per vertex, the unit area-weighted normal of its faces at the simulated positions (zero
   /// for a vertex without faces); #V by 3 columns as mesh().current.
   Eigen::Matrix3Xd normals() const;
@@ -287,8 +298,9 @@ class SkinnedSoftBody {
   const skin::Pose& pose() const;
   /// The global versor of every joint for pose() (joint space → mesh space).
   std::vector<skin::Versor> joint_transforms() const;
-  /// Draws the skeleton (joint to parent, yellow) and, for every driven node in Bullet, the
-  /// offset to its skinned target (cyan). Called by the plugin's action from
+  /// Draws the skeleton (joint to parent, yellow), for every driven node in Bullet the offset
+  /// to its skinned target (cyan), the tear's two borders (orange, one line per border edge)
+  /// and the blade of the last tear sample (magenta). Called by the plugin's action from
   /// btDynamicsWorld::debugDrawWorld; Bullet draws the pieces themselves.
   void debug_draw(btIDebugDraw& drawer) const;
 
