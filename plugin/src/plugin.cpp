@@ -30,7 +30,17 @@ struct Plugin::Action : btActionInterface {
     } flag(stepping);
     ++substeps;
     time += static_cast<double>(dt);
-    for (auto& body : bodies) body->update(static_cast<double>(dt), time);
+    // Before the drive, what Bullet's last substep and this one's prediction left (so that the
+    // drive never reads it); after it, what the drive wrote.
+    const auto check = [&](std::size_t i, bool after_drive) {
+      if (const auto bad = bodies[i]->first_non_finite_node())
+        throw NonFiniteState(substeps, time, i, *bad, after_drive);
+    };
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      check(i, false);
+      bodies[i]->update(static_cast<double>(dt), time);
+      check(i, true);
+    }
     for (auto& hook : hooks) hook(static_cast<double>(dt));
   }
   void debugDraw(btIDebugDraw* drawer) override {
