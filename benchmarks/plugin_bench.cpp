@@ -120,8 +120,8 @@ void BM_ActionOnly(benchmark::State& state) {
 BENCHMARK(BM_ActionOnly)->Unit(benchmark::kMicrosecond);
 
 // The per-substep finiteness check (non_finite_state.hpp): one pass over every node's position
-// and velocity; the action runs it twice a substep (before and after the drive). Its share of
-// a step: 2 × this against BM_StepSkinned.
+// and velocity, once a substep (before the drive). Its share of a step: this against
+// BM_StepSkinned.
 void BM_NonFiniteCheck(benchmark::State& state) {
   LiveArm a;
   for (auto _ : state) benchmark::DoNotOptimize(a.body->first_non_finite_node());

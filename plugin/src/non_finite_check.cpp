@@ -37,27 +37,25 @@ std::optional<NonFiniteNode> SkinnedSoftBody::Impl::first_non_finite_node() cons
 
 namespace {
 
-std::string describe(long long substep, double time, std::size_t body, const NonFiniteNode& n,
-                     bool after_drive) {
+std::string describe(long long substep, double time, std::size_t body, const NonFiniteNode& n) {
   std::ostringstream s;
   s << "the simulation went non-finite at substep " << substep << " (t = " << time
     << " s): skinned body " << body << ", piece " << n.piece << ", node " << n.node
     << " (mesh vertex " << n.vertex << ") has " << (n.position ? "position" : "velocity") << " ("
-    << n.value.x() << ", " << n.value.y() << ", " << n.value.z() << ") "
-    << (after_drive ? "after the plugin's drive" : "after Bullet's step and prediction")
-    << "; too large a time step, force or stiffness for the material?";
+    << n.value.x() << ", " << n.value.y() << ", " << n.value.z()
+    << ") at the start of that substep (what the one before and Bullet's prediction left); too "
+       "large a time step, force or stiffness for the material?";
   return s.str();
 }
 
 }  // namespace
 
 NonFiniteState::NonFiniteState(long long substep, double time, std::size_t body,
-                               const NonFiniteNode& node, bool after_drive)
-    : std::runtime_error(describe(substep, time, body, node, after_drive)),
+                               const NonFiniteNode& node)
+    : std::runtime_error(describe(substep, time, body, node)),
       substep_(substep),
       time_(time),
       body_(body),
-      node_(node),
-      after_drive_(after_drive) {}
+      node_(node) {}
 
 }  // namespace conform::bullet

@@ -30,16 +30,12 @@ struct Plugin::Action : btActionInterface {
     } flag(stepping);
     ++substeps;
     time += static_cast<double>(dt);
-    // Before the drive, what Bullet's last substep and this one's prediction left (so that the
-    // drive never reads it); after it, what the drive wrote.
-    const auto check = [&](std::size_t i, bool after_drive) {
-      if (const auto bad = bodies[i]->first_non_finite_node())
-        throw NonFiniteState(substeps, time, i, *bad, after_drive);
-    };
+    // One pass per substep, before the drive: it sees everything since the last one (the last
+    // substep's drive and Bullet's solve, this substep's prediction), and no drive reads a NaN.
     for (std::size_t i = 0; i < bodies.size(); ++i) {
-      check(i, false);
+      if (const auto bad = bodies[i]->first_non_finite_node())
+        throw NonFiniteState(substeps, time, i, *bad);
       bodies[i]->update(static_cast<double>(dt), time);
-      check(i, true);
     }
     for (auto& hook : hooks) hook(static_cast<double>(dt));
   }

@@ -301,7 +301,7 @@ class SkinnedSoftBody {
   /// One substep, called by the plugin's action: pose, skin, drive nodes, re-apply rest lengths.
   void update(double dt, double time);
   /// The first node (pieces in slot order, nodes in body order) whose position or velocity is
-  /// NaN or infinite, or none. One pass over the nodes; the plugin's action calls it after
+  /// NaN or infinite, or none. One pass over the nodes; the plugin's action calls it before
   /// every substep's update() and throws NonFiniteState (non_finite_state.hpp) on a hit.
   std::optional<NonFiniteNode> first_non_finite_node() const;
   /// Skinning only, for `time` (targets() are then valid); used by update() and benchmarks.
