@@ -119,6 +119,16 @@ void BM_ActionOnly(benchmark::State& state) {
 }
 BENCHMARK(BM_ActionOnly)->Unit(benchmark::kMicrosecond);
 
+// The per-substep finiteness check (non_finite_state.hpp): one pass over every node's position
+// and velocity, once a substep (before the drive). Its share of a step: this against
+// BM_StepSkinned.
+void BM_NonFiniteCheck(benchmark::State& state) {
+  LiveArm a;
+  for (auto _ : state) benchmark::DoNotOptimize(a.body->first_non_finite_node());
+  state.counters["nodes"] = a.body->vertex_count();
+}
+BENCHMARK(BM_NonFiniteCheck)->Unit(benchmark::kMicrosecond);
+
 // Skinning alone (pose, per-bone kernels, eq 17 vertex loop) for one substep.
 void BM_SkinTargets(benchmark::State& state) {
   LiveArm a(1);

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "run_output.hpp"
@@ -59,5 +60,13 @@ const SceneKind* find_builtin(const std::string& name);
 /// prepares it. Throws SceneError or std::runtime_error (unreadable file, bad JSON).
 std::unique_ptr<Scene> load_scene(const std::string& name_or_file,
                                   const std::vector<std::string>& assignments, int steps_override);
+/// The same for the text of a scene file (`file` names it in errors and gives the scene's name).
+std::unique_ptr<Scene> load_scene_text(std::string_view text, const std::string& file,
+                                       const std::vector<std::string>& assignments,
+                                       int steps_override);
+/// The same for parsed JSON: --set assignments, the kind's factory. Throws SceneError.
+std::unique_ptr<Scene> prepare_scene(Json scene, const std::string& name,
+                                     const std::vector<std::string>& assignments,
+                                     int steps_override);
 
 }  // namespace conform::scenes

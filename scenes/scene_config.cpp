@@ -15,7 +15,8 @@ constexpr int kShownDepth = 8;
 // and a scene file nested 100,000 deep overflowed the stack while its error was printed.
 void append_shown(const Json& value, int depth, std::string& out) {
   if (!value.is_structured()) {
-    out += value.dump();
+    // Replace, not throw: a --set value is any bytes, and its error must still print.
+    out += value.dump(-1, ' ', false, Json::error_handler_t::replace);
     return;
   }
   const bool array = value.is_array();
@@ -28,7 +29,7 @@ void append_shown(const Json& value, int depth, std::string& out) {
   for (auto it = value.begin(); it != value.end() && out.size() <= kShownChars; ++it) {
     if (!first) out += ',';
     first = false;
-    if (!array) out += Json(it.key()).dump() + ':';
+    if (!array) out += Json(it.key()).dump(-1, ' ', false, Json::error_handler_t::replace) + ':';
     append_shown(it.value(), depth + 1, out);
   }
   out += array ? ']' : '}';
@@ -196,6 +197,13 @@ void apply_set(Json& scene, const std::string& assignment) {
     throw SceneError(assignment, "(none)", "--set needs KEY=VALUE");
   const std::string key = assignment.substr(0, eq);
   const std::string text = assignment.substr(eq + 1);
+  // Scene text is UTF-8 (the JSON parser refuses anything else); so must a --set KEY=VALUE be,
+  // or its error, and summary.json at the end of the run, could not be written.
+  try {
+    (void)Json(assignment).dump();
+  } catch (const Json::type_error&) {
+    throw SceneError(key, "(not shown)", "--set KEY=VALUE must be UTF-8 text");
+  }
   Json value = Json::parse(text, nullptr, /*allow_exceptions=*/false);
   if (value.is_discarded()) value = text;
   Json* node = &scene;

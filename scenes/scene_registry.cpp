@@ -40,27 +40,36 @@ const SceneKind* find_builtin(const std::string& name) {
 
 std::unique_ptr<Scene> load_scene(const std::string& name_or_file,
                                   const std::vector<std::string>& assignments, int steps_override) {
-  Json scene;
-  std::string name;
-  if (const SceneKind* b = find_builtin(name_or_file)) {
-    scene = Json::parse(b->json);
-    name = b->name;
-  } else {
-    std::ifstream in(name_or_file);
-    if (!in) {
-      std::string names;
-      for (const auto& s : scene_kinds())
-        names += (names.empty() ? "" : ", ") + std::string(s.name);
-      throw std::runtime_error("'" + name_or_file + "' is neither a built-in scene (" + names +
-                               ") nor a readable scene file");
-    }
-    try {
-      scene = Json::parse(in, nullptr, true, /*ignore_comments=*/true);
-    } catch (const Json::parse_error& e) {
-      throw std::runtime_error(name_or_file + ": not valid JSON: " + e.what());
-    }
-    name = std::filesystem::path(name_or_file).stem().string();
+  if (const SceneKind* b = find_builtin(name_or_file))
+    return prepare_scene(Json::parse(b->json), b->name, assignments, steps_override);
+  std::ifstream in(name_or_file);
+  if (!in) {
+    std::string names;
+    for (const auto& s : scene_kinds()) names += (names.empty() ? "" : ", ") + std::string(s.name);
+    throw std::runtime_error("'" + name_or_file + "' is neither a built-in scene (" + names +
+                             ") nor a readable scene file");
   }
+  std::ostringstream text;
+  text << in.rdbuf();
+  return load_scene_text(text.str(), name_or_file, assignments, steps_override);
+}
+
+std::unique_ptr<Scene> load_scene_text(std::string_view text, const std::string& file,
+                                       const std::vector<std::string>& assignments,
+                                       int steps_override) {
+  Json scene;
+  try {
+    scene = Json::parse(text, nullptr, true, /*ignore_comments=*/true);
+  } catch (const Json::exception& e) {  // parse_error, and out_of_range for 1e400
+    throw std::runtime_error(file + ": not valid JSON: " + e.what());
+  }
+  return prepare_scene(std::move(scene), std::filesystem::path(file).stem().string(), assignments,
+                       steps_override);
+}
+
+std::unique_ptr<Scene> prepare_scene(Json scene, const std::string& name,
+                                     const std::vector<std::string>& assignments,
+                                     int steps_override) {
   for (const auto& a : assignments) apply_set(scene, a);
   if (!scene.is_object()) throw SceneError("(scene)", show(scene), "must be a JSON object");
   const auto it = scene.find("scene");

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "conform/bullet/convert.hpp"
 
@@ -11,6 +13,15 @@ SoftWorld::SoftWorld(const CommonSettings& c)
     : bullet::SoftWorld(bullet::to_bt(c.gravity)), dt(c.dt / c.substeps), substeps(c.substeps) {
   world.getSolverInfo().m_numIterations = c.solver_iterations;
   plugin = std::make_unique<bullet::Plugin>(world);
+}
+
+void SoftWorld::step() {
+  ++steps_done;
+  try {
+    bullet::SoftWorld::step(dt, substeps);
+  } catch (const bullet::NonFiniteState& e) {
+    throw std::runtime_error("step " + std::to_string(steps_done) + ": " + e.what());
+  }
 }
 
 OffsetStats offsets(const bullet::SkinnedSoftBody& body,

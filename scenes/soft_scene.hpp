@@ -19,11 +19,13 @@ struct SoftWorld : bullet::SoftWorld {
   std::unique_ptr<bullet::Plugin> plugin;
   double dt = 1.0 / 60;
   int substeps = 1;
+  long long steps_done = 0;
 
   explicit SoftWorld(const CommonSettings& c);
   ~SoftWorld() { plugin.reset(); }  // the plugin's bodies leave the world first
-  /// One step of c.dt in c.substeps fixed substeps.
-  void step() { bullet::SoftWorld::step(dt, substeps); }
+  /// One step of c.dt in c.substeps fixed substeps. A simulation gone non-finite (the plugin's
+  /// bullet::NonFiniteState) ends it with an error naming the scene's step as well.
+  void step();
 };
 
 /// Distances of nodes from their skinned targets.

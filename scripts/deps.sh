@@ -14,6 +14,7 @@ packages=(
   f3d xvfb xauth  # conform run's pictures: f3d renders them under a virtual X display (xvfb-run)
   ffmpeg          # conform run's video of the pictures (run.gif / run.mp4)
   libtinygltf-dev # conform run's run.glb (glTF 2.0 binary)
+  clang-14 libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer targets (CI's bounded fuzz run)
 )
 
 missing=()

@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Builds everything and runs the whole test suite with ctest.
 #
-# Under CI (CI=true), or when asked locally, two more configurations run after the main one:
+# Under CI (CI=true), or when asked locally, more configurations run after the main one:
 #   - ASan+UBSan build of the core tests (cga_*, ik_*)     CONFORM_SANITIZE_TESTS=1 / CONFORM_SKIP_SANITIZE=1
 #   - Debian's double-precision Bullet: plugin tests and   CONFORM_DOUBLE_TESTS=1   / CONFORM_SKIP_DOUBLE=1
 #     the find_package install test (-DCONFORM_DOUBLE=ON)
+#   - a bounded libFuzzer run of every tests/fuzz target    CONFORM_FUZZ_TESTS=1     / CONFORM_SKIP_FUZZ=1
+#     (scripts/fuzz.sh, CONFORM_FUZZ_SECONDS each, 20 s by default; clang)
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 build="${CONFORM_BUILD_DIR:-$root/build}"
@@ -65,4 +67,29 @@ if [[ "${CONFORM_SKIP_DOUBLE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_DOUB
   echo "conform: plugin tests against double-precision Bullet"
   extra_configuration "$build-double" '^(plugin_|install_test)' 'plugin_*_test.cpp' \
     -DCMAKE_BUILD_TYPE=Release -DCONFORM_DOUBLE=ON
+fi
+
+# libFuzzer needs clang and its fuzzer runtime (libclang-rt-14-dev); probe both, as above.
+fuzzer_runs() {
+  local dir cxx
+  cxx="$(command -v clang++-14 || command -v clang++ || true)"
+  [[ -n "$cxx" ]] || return 1
+  dir="$(mktemp -d)"
+  echo 'extern "C" int LLVMFuzzerTestOneInput(const unsigned char*, unsigned long) { return 0; }' \
+    >"$dir/probe.cpp"
+  "$cxx" -fsanitize=fuzzer,address,undefined "$dir/probe.cpp" -o "$dir/probe" >/dev/null 2>&1 &&
+    "$dir/probe" -runs=1 >/dev/null 2>&1
+  local rc=$?
+  rm -rf "$dir"
+  return $rc
+}
+
+if [[ "${CONFORM_SKIP_FUZZ:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_FUZZ_TESTS:-0}" == "1" ) ]]; then
+  if fuzzer_runs; then
+    echo "conform: fuzz targets, ${CONFORM_FUZZ_SECONDS:-20} s each"
+    CONFORM_FUZZ_BUILD_DIR="$build-fuzz" "$root/scripts/fuzz.sh" "${CONFORM_FUZZ_SECONDS:-20}"
+  else
+    echo "conform: WARNING: clang's libFuzzer runtime is missing or cannot run here" \
+      "(scripts/deps.sh installs clang-14 and libclang-rt-14-dev); the fuzz run is skipped" >&2
+  fi
 fi

@@ -30,7 +30,13 @@ struct Plugin::Action : btActionInterface {
     } flag(stepping);
     ++substeps;
     time += static_cast<double>(dt);
-    for (auto& body : bodies) body->update(static_cast<double>(dt), time);
+    // One pass per substep, before the drive: it sees everything since the last one (the last
+    // substep's drive and Bullet's solve, this substep's prediction), and no drive reads a NaN.
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      if (const auto bad = bodies[i]->first_non_finite_node())
+        throw NonFiniteState(substeps, time, i, *bad);
+      bodies[i]->update(static_cast<double>(dt), time);
+    }
     for (auto& hook : hooks) hook(static_cast<double>(dt));
   }
   void debugDraw(btIDebugDraw* drawer) override {

@@ -522,6 +522,9 @@ void SkinnedSoftBody::debug_draw(btIDebugDraw& drawer) const {
 void SkinnedSoftBody::update(double dt, double time) {
   impl_->update(dt, time);
 }
+std::optional<NonFiniteNode> SkinnedSoftBody::first_non_finite_node() const {
+  return impl_->first_non_finite_node();
+}
 void SkinnedSoftBody::skin_targets(double time) {
   impl_->skin_targets(time);
 }

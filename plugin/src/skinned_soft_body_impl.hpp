@@ -134,6 +134,7 @@ struct SkinnedSoftBody::Impl {
 
   // --- Skin drive (skin_drive.cpp): update() is the one per-substep entry point ---
   void update(double dt, double time);
+  std::optional<NonFiniteNode> first_non_finite_node() const;  // non_finite_check.cpp
   void skin_targets(double time);
   void drive_nodes(Piece& piece, double dt);
   // The membrane (Material::model == membrane) replaces drive_nodes and the rest lengths.

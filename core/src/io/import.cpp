@@ -14,6 +14,7 @@
 #include <unordered_map>
 
 #include "conform/io/isolate.hpp"
+#include "conform/io/model_check.hpp"
 #include "conform/io/model_wire.hpp"
 #include "conform/io/weld_model.hpp"
 #include "conform/skin/procedural_arm.hpp"
@@ -651,12 +652,17 @@ SkinnedModel import_isolated(const std::string& file, const ImportOptions& optio
   const Isolated r =
       run_isolated([&] { return encode_model(import_here(file, options)); }, options.isolation);
   if (r.status != Isolated::Status::ok) throw isolation_error(file, r, options.isolation);
+  SkinnedModel model;
   try {
-    return decode_model(r.result);
+    model = decode_model(r.result);
   } catch (const std::exception& e) {
     throw ImportError(file,
                       std::string("the isolated import sent a bad result (") + e.what() + ")");
   }
+  // A child whose memory assimp corrupted may still send a whole message of garbage.
+  if (const std::string e = check_model(model); !e.empty())
+    throw ImportError(file, "the isolated import sent an inconsistent model (" + e + ")");
+  return model;
 }
 
 }  // namespace

@@ -41,8 +41,11 @@ std::string InfluenceLists::validate(std::int32_t bone_count, double tolerance) 
   if (offsets.empty() || offsets.front() != 0 ||
       static_cast<std::size_t>(offsets.back()) != bones.size() || bones.size() != weights.size())
     return "influence lists are inconsistent";
-  for (std::size_t v = 0; v + 1 < offsets.size(); ++v) {
+  // All offsets first: one past the end in the middle of the list ([0, 100, 5] over 5 bones)
+  // would otherwise be read before the decrease after it is seen.
+  for (std::size_t v = 0; v + 1 < offsets.size(); ++v)
     if (offsets[v + 1] < offsets[v]) return "influence lists are inconsistent";
+  for (std::size_t v = 0; v + 1 < offsets.size(); ++v) {
     double sum = 0;
     for (auto i = offsets[v]; i < offsets[v + 1]; ++i) {
       const auto b = bones[static_cast<std::size_t>(i)];

@@ -41,9 +41,11 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
+#include "conform/bullet/non_finite_state.hpp"
 #include "conform/bullet/piece.hpp"
 #include "conform/cga/plane.hpp"
 #include "conform/membrane/skin_material.hpp"
@@ -310,6 +312,10 @@ class SkinnedSoftBody {
 
   /// One substep, called by the plugin's action: pose, skin, drive nodes, re-apply rest lengths.
   void update(double dt, double time);
+  /// The first node (pieces in slot order, nodes in body order) whose position or velocity is
+  /// NaN or infinite, or none. One pass over the nodes; the plugin's action calls it before
+  /// every substep's update() and throws NonFiniteState (non_finite_state.hpp) on a hit.
+  std::optional<NonFiniteNode> first_non_finite_node() const;
   /// Skinning only, for `time` (targets() are then valid); used by update() and benchmarks.
   void skin_targets(double time);
 

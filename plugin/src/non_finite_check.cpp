@@ -1,0 +1,61 @@
+// The per-substep finiteness check (non_finite_state.hpp): one pass over every piece's nodes.
+#include <cmath>
+#include <sstream>
+
+#include "piece_books.hpp"
+
+namespace conform::bullet {
+
+namespace {
+
+bool finite(const btVector3& v) {
+  // A finite sum means three finite terms (a NaN or infinite one makes it NaN or infinite); the
+  // sum of large finite terms may overflow, so only then are they tested one by one.
+  return std::isfinite(v.x() + v.y() + v.z()) ||
+         (std::isfinite(v.x()) && std::isfinite(v.y()) && std::isfinite(v.z()));
+}
+
+}  // namespace
+
+std::optional<NonFiniteNode> SkinnedSoftBody::Impl::first_non_finite_node() const {
+  for (std::size_t slot = 0; slot < pieces_.size(); ++slot) {
+    const Piece* piece = pieces_[slot].get();
+    if (!piece || !piece->body) continue;
+    const btSoftBody& body = *piece->body;
+    for (int i = 0; i < body.m_nodes.size(); ++i) {
+      const btSoftBody::Node& n = body.m_nodes[i];
+      const bool x = finite(n.m_x);
+      if (x && finite(n.m_v)) continue;
+      const btVector3& bad = x ? n.m_v : n.m_x;
+      return NonFiniteNode{static_cast<std::int32_t>(slot), i,
+                           piece->node_vertex[static_cast<std::size_t>(i)], !x,
+                           Eigen::Vector3d(double(bad.x()), double(bad.y()), double(bad.z()))};
+    }
+  }
+  return std::nullopt;
+}
+
+namespace {
+
+std::string describe(long long substep, double time, std::size_t body, const NonFiniteNode& n) {
+  std::ostringstream s;
+  s << "the simulation went non-finite at substep " << substep << " (t = " << time
+    << " s): skinned body " << body << ", piece " << n.piece << ", node " << n.node
+    << " (mesh vertex " << n.vertex << ") has " << (n.position ? "position" : "velocity") << " ("
+    << n.value.x() << ", " << n.value.y() << ", " << n.value.z()
+    << ") at the start of that substep (what the one before and Bullet's prediction left); too "
+       "large a time step, force or stiffness for the material?";
+  return s.str();
+}
+
+}  // namespace
+
+NonFiniteState::NonFiniteState(long long substep, double time, std::size_t body,
+                               const NonFiniteNode& node)
+    : std::runtime_error(describe(substep, time, body, node)),
+      substep_(substep),
+      time_(time),
+      body_(body),
+      node_(node) {}
+
+}  // namespace conform::bullet
