@@ -146,6 +146,62 @@ TEST(Cut, CapsCloseEveryPieceAndKeepVolume) {
   expect_valid(m, in, "capped icosphere");
 }
 
+// Two closed meshes as one (positions, influences and faces only).
+SkinnedMesh together(const SkinnedMesh& a, const SkinnedMesh& b) {
+  const Eigen::Index na = a.rest.cols(), nb = b.rest.cols();
+  Eigen::Matrix3Xd x(3, na + nb);
+  x << a.current, b.current;
+  Eigen::Matrix<std::int32_t, kMaxInfluences, Eigen::Dynamic> bones(kMaxInfluences, na + nb);
+  bones << a.bones, b.bones;
+  Eigen::Matrix<double, kMaxInfluences, Eigen::Dynamic> weights(kMaxInfluences, na + nb);
+  weights << a.weights, b.weights;
+  SkinnedMesh m;
+  m.rest = x, m.current = x, m.bones = bones, m.weights = weights;
+  m.faces = a.faces;
+  for (Face f : b.faces) {
+    for (auto& v : f) v += std::int32_t(na);
+    m.faces.push_back(f);
+  }
+  return m;
+}
+
+TEST(Cut, CapsFollowEachLoopsDirectionWhenPiecesOverlapOrTurnInsideOut) {
+  // A running simulation's pieces overlap: a small closed sphere inside a larger one. The
+  // inner sphere's loop lies inside the outer's but is no hole of it (it runs the same way):
+  // each is capped as a disc of its own, and every piece is closed and oriented (one section
+  // for both made the inner loop a hole: cap faces oriented like their neighbours).
+  const SkinnedMesh in = together(make_icosphere(3, 1.0), make_icosphere(3, 0.5));
+  SkinnedMesh m = in;
+  Adjacency adj(m);
+  const auto out = cut(m, adj, Plane::from_normal_distance({0.1, 0.2, 1}, 0.1), {.cap = true});
+  ASSERT_EQ(out.result.status, CutStatus::Cut);
+  EXPECT_EQ(out.result.loops, 2);
+  EXPECT_EQ(out.result.capped_loops, 2) << out.result.message;
+  EXPECT_EQ(out.result.nested_loops, 0);
+  ASSERT_EQ(out.pieces.count, 4);
+  for (std::int32_t p = 0; p < out.pieces.count; ++p) {
+    SkinnedMesh piece = m;
+    piece.faces.clear();
+    for (auto f : out.pieces.faces_of(p)) piece.faces.push_back(m.faces[std::size_t(f)]);
+    const MeshReport r = check_mesh(piece);
+    EXPECT_TRUE(r.closed() && r.oriented() && r.manifold()) << "piece " << p << ": " << r.summary();
+    EXPECT_GT(signed_volume(piece), 0) << "piece " << p;
+  }
+  // An inside-out sphere (every face reversed): its loop runs against its nesting, so it is
+  // left open with a message rather than capped with misoriented faces.
+  SkinnedMesh inverted = make_icosphere(3, 1.0);
+  for (Face& f : inverted.faces) std::swap(f[1], f[2]);
+  Adjacency inverted_adj(inverted);
+  const auto open =
+      cut(inverted, inverted_adj, Plane::from_normal_distance({0, 0, 1}, 0.2), {.cap = true});
+  ASSERT_EQ(open.result.status, CutStatus::Cut);
+  EXPECT_EQ(open.result.loops, 1);
+  EXPECT_EQ(open.result.capped_loops, 0);
+  EXPECT_NE(open.result.message.find("against its nesting"), std::string::npos)
+      << open.result.message;
+  EXPECT_EQ(check_mesh(inverted).misoriented_edges, 0) << check_mesh(inverted).summary();
+}
+
 TEST(Cut, OnePlaneManyPieces) {
   // A U-shaped tube (the cylinder bent by hand) cut across both legs gives three pieces.
   SkinnedMesh m = make_cylinder(24, 40, 0.1, 2.0);
