@@ -19,10 +19,7 @@
 //   5. optionally cap the cross-section, both sides: every closed cut loop goes into one
 //      triangulation of the section (cap.hpp: CGAL's constrained Delaunay triangulation when
 //      built with CGAL, else ear clipping with holes bridged), filled by nesting parity, so
-//      loops inside loops (a hollow tube, a torus cut through its hole) give rings. A loop
-//      inside another that runs the same way (pieces overlapping in the plane) is capped as
-//      a disc of its own; one running against its nesting with nothing around it (an
-//      inside-out surface) is left open, with a message.
+//      loops inside loops (a hollow tube, a torus cut through its hole) give rings.
 // Pieces are then the connected components (label_pieces), so one plane may give many.
 //
 // Regional cuts: with options.region (cut_region.hpp), step 2's result is grouped into
