@@ -16,6 +16,9 @@ std::atomic<long> g_allocations{0};
 // Every unaligned form is replaced, so that whatever one form allocates the matching delete
 // frees with the same allocator (a sanitizer's runtime supplies the forms left out, and would
 // see memory from its own operator new(nothrow) freed here with free()).
+// These replacements are the global allocator, so malloc/free behind new/delete is the pairing
+// here; GCC's -Wmismatched-new-delete (when it inlines one into a caller) does not know that.
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
 void* operator new(std::size_t n) {
   g_allocations.fetch_add(1, std::memory_order_relaxed);
   if (void* p = std::malloc(n ? n : 1)) return p;
