@@ -55,12 +55,12 @@ if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SA
 fi
 
 # The whole suite (every GoogleTest program and shell test, the install test included) in an
-# ASan+UBSan build, with leak detection. CONFORM_SANITIZED=1 tells the few tests that size
-# themselves to run smaller.
+# ASan+UBSan build, with leak detection (tests/sanitizer/lsan.supp: leaks inside third-party
+# libraries only). CONFORM_SANITIZED=1 tells the few tests that size themselves to run smaller.
 if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SANITIZE_TESTS:-0}" == "1" ) ]]; then
   echo "conform: the whole suite under ASan+UBSan"
   sanitize_start=$SECONDS
-  ASAN_OPTIONS=detect_leaks=1 \
+  ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS="suppressions=$root/tests/sanitizer/lsan.supp" \
     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 CONFORM_SANITIZED=1 \
     extra_configuration "$build-sanitize" '.' '*_test.cpp' \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCONFORM_SANITIZE=ON
