@@ -166,7 +166,7 @@ SkinnedMesh together(const SkinnedMesh& a, const SkinnedMesh& b) {
   return m;
 }
 
-TEST(Cut, CapsFollowEachLoopsDirectionWhenPiecesOverlapOrTurnInsideOut) {
+TEST(Cut, CapsFollowEachLoopsDirectionWhenPiecesOverlap) {
   // A running simulation's pieces overlap: a small closed sphere inside a larger one. The
   // inner sphere's loop lies inside the outer's but is no hole of it (it runs the same way):
   // each is capped as a disc of its own, and every piece is closed and oriented (one section
@@ -188,19 +188,6 @@ TEST(Cut, CapsFollowEachLoopsDirectionWhenPiecesOverlapOrTurnInsideOut) {
     EXPECT_TRUE(r.closed() && r.oriented() && r.manifold()) << "piece " << p << ": " << r.summary();
     EXPECT_GT(signed_volume(piece), 0) << "piece " << p;
   }
-  // An inside-out sphere (every face reversed): its loop runs against its nesting, so it is
-  // left open with a message rather than capped with misoriented faces.
-  SkinnedMesh inverted = make_icosphere(3, 1.0);
-  for (Face& f : inverted.faces) std::swap(f[1], f[2]);
-  Adjacency inverted_adj(inverted);
-  const auto open =
-      cut(inverted, inverted_adj, Plane::from_normal_distance({0, 0, 1}, 0.2), {.cap = true});
-  ASSERT_EQ(open.result.status, CutStatus::Cut);
-  EXPECT_EQ(open.result.loops, 1);
-  EXPECT_EQ(open.result.capped_loops, 0);
-  EXPECT_NE(open.result.message.find("against its nesting"), std::string::npos)
-      << open.result.message;
-  EXPECT_EQ(check_mesh(inverted).misoriented_edges, 0) << check_mesh(inverted).summary();
 }
 
 TEST(Cut, OnePlaneManyPieces) {

@@ -57,8 +57,7 @@ OrientedSections oriented_sections(const std::vector<std::vector<Eigen::Vector2d
   std::vector<std::size_t> pending(loops.size());
   std::iota(pending.begin(), pending.end(), std::size_t(0));
   std::vector<std::int32_t> global;
-  // Each round caps a group or drops a loop (a depth-0 loop against its nesting stays so in
-  // every subset), so this ends.
+  // Each round caps a group (its outermost loops always stay in it), so this ends.
   while (!pending.empty()) {
     std::vector<std::size_t> group = pending, deferred;
     SectionTriangulation section;
@@ -72,10 +71,9 @@ OrientedSections oriented_sections(const std::vector<std::vector<Eigen::Vector2d
       std::vector<std::size_t> agree;
       for (std::size_t k = 0; k < group.size(); ++k) {
         const bool even = section.depth[k] % 2 == 0;
-        if (counter_clockwise[group[k]] == even)
+        // An outermost loop is kept either way (an inside-out surface is capped as before).
+        if (counter_clockwise[group[k]] == even || section.depth[k] == 0)
           agree.push_back(group[k]);
-        else if (section.depth[k] == 0)
-          ++out.against_nesting;
         else
           deferred.push_back(group[k]);
       }

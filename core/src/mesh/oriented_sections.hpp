@@ -9,8 +9,8 @@
 // faces oriented like their neighbours (edges used twice in one direction). So the loops are
 // triangulated in groups: the loops against their nesting are set aside and the others
 // triangulated again until every loop of the group agrees, and the loops set aside make the
-// next group (where the overlapping piece's loop is an outer loop of its own). A loop against
-// its nesting at depth 0 (clockwise with nothing around it) stays uncapped.
+// next group (where the overlapping piece's loop is an outer loop of its own). An outermost
+// loop is capped as it is (an inside-out surface keeps the old caps: a known limit).
 #pragma once
 
 #include <array>
@@ -27,7 +27,7 @@ struct OrientedSections {
   std::vector<std::array<std::int32_t, 3>> triangles;
   std::int32_t capped_loops = 0;
   std::int32_t nested_loops = 0;     // capped loops inside another loop of their group
-  std::int32_t against_nesting = 0;  // loops left uncapped: clockwise with nothing around them
+  std::int32_t against_nesting = 0;  // always 0: outermost loops are capped as they are
   std::string problem;               // a triangulation's problem; then no triangles at all
 };
 
