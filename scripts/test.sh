@@ -2,7 +2,8 @@
 # Builds everything and runs the whole test suite with ctest.
 #
 # Under CI (CI=true), or when asked locally, more configurations run after the main one:
-#   - ASan+UBSan build of the core tests (cga_*, ik_*)     CONFORM_SANITIZE_TESTS=1 / CONFORM_SKIP_SANITIZE=1
+#   - ASan+UBSan build (leak checks) of the core, import-isolation, lifetime and soak tests;
+#     the whole suite with CONFORM_SANITIZE_ALL=1         CONFORM_SANITIZE_TESTS=1 / CONFORM_SKIP_SANITIZE=1
 #   - Debian's double-precision Bullet: plugin tests and   CONFORM_DOUBLE_TESTS=1   / CONFORM_SKIP_DOUBLE=1
 #     the find_package install test (-DCONFORM_DOUBLE=ON)
 #   - a bounded libFuzzer run of every tests/fuzz target    CONFORM_FUZZ_TESTS=1     / CONFORM_SKIP_FUZZ=1
@@ -56,11 +57,24 @@ if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SA
   CONFORM_SKIP_SANITIZE=1
 fi
 
+# ASan+UBSan with leak detection (tests/sanitizer/lsan.supp: leaks inside third-party libraries
+# only). CI runs the core, import-isolation, lifetime and soak tests there; CONFORM_SANITIZE_ALL=1
+# runs the whole suite (every GoogleTest program and shell test, the install test included).
+# CONFORM_SANITIZED=1 tells the few tests that size themselves to run smaller.
 if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SANITIZE_TESTS:-0}" == "1" ) ]]; then
-  echo "conform: core tests under ASan+UBSan"
-  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    extra_configuration "$build-sanitize" '^(cga_|ik_)' 'cga_*_test.cpp ik_*_test.cpp' \
+  sanitize_start=$SECONDS
+  sanitized_regex='^(cga_|ik_|skin_alloc_test|io_broken_test|plugin_lifetime_test|plugin_soak_test)'
+  sanitized_sources='cga_*_test.cpp ik_*_test.cpp skin_alloc_test.cpp io_broken_test.cpp plugin_lifetime_test.cpp plugin_soak_test.cpp'
+  if [[ "${CONFORM_SANITIZE_ALL:-0}" == "1" ]]; then
+    sanitized_regex='.'
+    sanitized_sources='*_test.cpp'
+  fi
+  echo "conform: tests under ASan+UBSan ($sanitized_regex)"
+  ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS="suppressions=$root/tests/sanitizer/lsan.supp" \
+    UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 CONFORM_SANITIZED=1 \
+    extra_configuration "$build-sanitize" "$sanitized_regex" "$sanitized_sources" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCONFORM_SANITIZE=ON
+  echo "conform: the sanitized stage took $((SECONDS - sanitize_start)) s"
 fi
 
 if [[ "${CONFORM_SKIP_DOUBLE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_DOUBLE_TESTS:-0}" == "1" ) ]]; then

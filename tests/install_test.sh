@@ -67,8 +67,17 @@ cmake -S "$work/right" -B "$work/right/build" -DCMAKE_PREFIX_PATH="$work/prefix"
   { cat "$work/right.log"; fail "a project of the package's Bullet precision was refused"; }
 echo "install_test: a project of $wrong-precision Bullet is refused at configure time, one of $mine configures"
 
+# A package built with CONFORM_SANITIZE holds instrumented code: its consumers must be built
+# with the same sanitizers (their runtime), as the sanitized CI stage does.
+sanitize_flags="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
+consumer_flags=()
+sanitized_package=0
+if grep -qE '^CONFORM_SANITIZE:BOOL=ON' "$build_dir/CMakeCache.txt"; then
+  consumer_flags=("-DCMAKE_CXX_FLAGS=$sanitize_flags")
+  sanitized_package=1
+fi
 cmake -S "$source_dir/tests/consumer" -B "$work/build" -DCMAKE_PREFIX_PATH="$work/prefix" \
-  -DCMAKE_BUILD_TYPE=Release -DCMAKE_EXPORT_COMPILE_COMMANDS=ON >/dev/null
+  -DCMAKE_BUILD_TYPE=Release -DCMAKE_EXPORT_COMPILE_COMMANDS=ON "${consumer_flags[@]}" >/dev/null
 cmake --build "$work/build" >/dev/null
 
 # What the consumer was compiled and linked with.
@@ -95,12 +104,15 @@ character=/usr/share/assimp/models/X/anim_test.x
 
 # The same application built with ASan and UBSan against the (unsanitized) package: no report.
 # Skipped, with a warning, where a sanitized program cannot start (address-space limits).
+# (A sanitized package's consumers above already were.)
 echo 'int main() { return 0; }' >"$work/probe.cpp"
-if c++ -fsanitize=address,undefined "$work/probe.cpp" -o "$work/probe" >/dev/null 2>&1 &&
+if [[ $sanitized_package == 1 ]]; then
+  echo "install_test: the package is sanitized, so the consumers above ran under ASan+UBSan"
+elif c++ -fsanitize=address,undefined "$work/probe.cpp" -o "$work/probe" >/dev/null 2>&1 &&
   "$work/probe" >/dev/null 2>&1; then
   cmake -S "$source_dir/tests/consumer" -B "$work/build-sanitize" -DCMAKE_PREFIX_PATH="$work/prefix" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-    "-DCMAKE_CXX_FLAGS=-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer" \
+    "-DCMAKE_CXX_FLAGS=$sanitize_flags" \
     >/dev/null
   cmake --build "$work/build-sanitize" --target application >/dev/null
   ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \

@@ -15,6 +15,7 @@
 #include "conform/mesh/analysis.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "plugin_world.hpp"
+#include "sanitized.hpp"
 
 using namespace conform;
 using conform::test::SoftWorld;
@@ -165,9 +166,10 @@ TEST(PluginStability, ThousandRandomEventsOnARunningArm) {
   RunningArm r;
   const bullet::SkinnedSoftBody& body = *r.body;
   const auto start = std::chrono::steady_clock::now();
-  // CONFORM_STABILITY_EVENTS overrides the count for diagnosis only.
+  // CONFORM_STABILITY_EVENTS overrides the count for diagnosis only; 250 in the sanitized stage.
   const char* override_events = std::getenv("CONFORM_STABILITY_EVENTS");
-  const int events = override_events ? std::atoi(override_events) : 1000;
+  const int events =
+      override_events ? std::atoi(override_events) : conform::test::trial_count(1000, 250);
   const std::clock_t cpu_start = std::clock();
   for (int e = 0; e < events; ++e) {
     const std::int32_t vertices_before = body.vertex_count();

@@ -101,23 +101,47 @@ void* run_job(void* arg) {
   _exit(job.sent ? 0 : 124);  // no atexit handlers, no flushing of the parent's copied buffers
 }
 
-// Reads the child's pipe to its end or until `seconds` have passed; false on timeout.
-bool read_until_closed(int fd, double seconds, std::string& out) {
+// The child's resident memory in bytes (0 when /proc cannot tell); used under ASan only.
+[[maybe_unused]] std::size_t resident_bytes(pid_t pid) {
+  const std::string path = "/proc/" + std::to_string(pid) + "/statm";
+  FILE* f = std::fopen(path.c_str(), "r");
+  if (!f) return 0;
+  unsigned long long pages = 0, resident = 0;
+  const bool read = std::fscanf(f, "%llu %llu", &pages, &resident) == 2;
+  std::fclose(f);
+  return read ? std::size_t(resident) * std::size_t(sysconf(_SC_PAGESIZE)) : 0;
+}
+
+enum class Ending { closed, timed_out, over_memory };
+
+// Reads the child's pipe to its end or until `seconds` have passed. Under ASan, where the
+// child has no RLIMIT_AS, its resident memory is polled (every 20 ms) against `memory_cap`.
+Ending read_until_closed(int fd, pid_t pid, double seconds, std::size_t memory_cap,
+                         std::string& out) {
   using Clock = std::chrono::steady_clock;
   const auto deadline = Clock::now() + std::chrono::duration<double>(seconds);
+#ifndef CONFORM_ASAN
+  (void)pid, (void)memory_cap;
+  const long long poll_ms = 1 << 30;
+#else
+  const long long poll_ms = 20;
+#endif
   char buffer[1 << 16];
   for (;;) {
     const auto left =
         std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
-    if (left.count() <= 0) return false;
+    if (left.count() <= 0) return Ending::timed_out;
     pollfd p{fd, POLLIN, 0};
-    const int ready = poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), 1 << 30)));
+    const int ready = poll(&p, 1, static_cast<int>(std::min<long long>(left.count(), poll_ms)));
     if (ready < 0 && errno == EINTR) continue;
-    if (ready < 0) return true;  // treated as a closed pipe: the report is then incomplete
-    if (ready == 0) return false;
+    if (ready < 0) return Ending::closed;  // taken as closed: the report is then incomplete
+#ifdef CONFORM_ASAN
+    if (resident_bytes(pid) > memory_cap) return Ending::over_memory;
+#endif
+    if (ready == 0) continue;
     const ssize_t n = read(fd, buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return true;
+    if (n <= 0) return Ending::closed;
     out.append(buffer, static_cast<std::size_t>(n));
   }
 }
@@ -202,15 +226,20 @@ Isolated run_isolated(const std::function<std::string()>& work, const IsolationL
   }
   close(fds[1]);
   std::string bytes;
-  const bool finished = read_until_closed(fds[0], limits.seconds, bytes);
+  const Ending ending = read_until_closed(fds[0], pid, limits.seconds, limits.memory_bytes, bytes);
   close(fds[0]);
-  if (!finished) kill(pid, SIGKILL);
+  if (ending != Ending::closed) kill(pid, SIGKILL);
   const int status = wait_for(pid);
-  if (!finished) {
+  if (ending == Ending::timed_out) {
     out.status = Isolated::Status::timed_out;
     std::ostringstream why;
     why << "still running after " << limits.seconds << " s";
     out.message = why.str();
+    return out;
+  }
+  if (ending == Ending::over_memory) {
+    out.status = Isolated::Status::out_of_memory;
+    out.message = "resident memory over the cap";
     return out;
   }
   return interpret(bytes, status);

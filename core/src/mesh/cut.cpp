@@ -9,6 +9,7 @@
 #include "conform/cga/point.hpp"
 #include "conform/mesh/detail/cut_predicates.hpp"
 #include "conform/mesh/detail/union_find.hpp"
+#include "oriented_sections.hpp"
 #include "quad_split.hpp"
 
 namespace conform::mesh {
@@ -828,19 +829,24 @@ class CutComputation {
     return loops2;
   }
 
-  // One triangulation of the section; each triangle caps both sides. Section triangles turn
+  // The triangulation of the section (in groups whose loops run as their nesting says,
+  // oriented_sections.hpp); each triangle caps both sides. Section triangles turn
   // counter-clockwise about n: the negative piece's cap faces +n as they are, the positive
   // piece's is reversed.
   void add_cap_faces(const std::vector<std::vector<Eigen::Vector2d>>& loops2,
                      const ForbiddenDiagonals& forbidden, std::vector<std::string>& problems) {
-    const SectionTriangulation section =
-        triangulate_section(loops2, options_.cap_triangulator, forbidden);
-    if (!section.ok()) {
+    const detail::OrientedSections section =
+        detail::oriented_sections(loops2, options_.cap_triangulator, forbidden);
+    if (!section.problem.empty()) {
       problems.push_back(section.problem);
       return;
     }
-    result_.capped_loops = static_cast<std::int32_t>(loops2.size());
-    for (auto d : section.depth) result_.nested_loops += d > 0;
+    if (section.against_nesting > 0)
+      problems.push_back(
+          "a cut loop runs against its nesting (an inside-out surface, or pieces overlapping "
+          "in the plane)");
+    result_.capped_loops = section.capped_loops;
+    result_.nested_loops = section.nested_loops;
     TopologyChange& ch = result_.change;
     ch.added_faces.reserve(ch.added_faces.size() + 2 * section.triangles.size());
     const auto first = static_cast<std::int32_t>(ch.added_faces.size());

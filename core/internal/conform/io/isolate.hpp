@@ -5,8 +5,9 @@
 // only ever sees those bytes. The child reports its own outcome (a tagged, length-prefixed
 // message) and only a complete report with exit status 0 counts as success, so that a crash
 // caught by a host's own handler (ASan's, an application's), which exits instead of dying by a
-// signal, is still a crash. The child has a memory cap (RLIMIT_AS, not under ASan, whose shadow
-// memory needs terabytes of address space) and a time cap after which it is killed, and it dies
+// signal, is still a crash. The child has a memory cap (RLIMIT_AS; under ASan, whose shadow
+// memory needs terabytes of address space, the caller polls the child's resident memory every
+// 20 ms instead and kills it over the cap) and a time cap after which it is killed, and it dies
 // with the thread that forked it (PR_SET_PDEATHSIG), also when that thread is killed.
 #pragma once
 

@@ -1,0 +1,95 @@
+#include "oriented_sections.hpp"
+
+#include <numeric>
+
+namespace conform::mesh::detail {
+
+namespace {
+
+double signed_area(const std::vector<Eigen::Vector2d>& loop) {
+  double twice = 0;
+  for (std::size_t i = 0, j = loop.size() - 1; i < loop.size(); j = i++)
+    twice += loop[j].x() * loop[i].y() - loop[i].x() * loop[j].y();
+  return twice / 2;
+}
+
+// The loops `group` (indices into `loops`) as a section of their own: their triangulation,
+// with the forbidden diagonals between their vertices, in the concatenation of `group`.
+struct GroupSection {
+  const std::vector<std::vector<Eigen::Vector2d>>& loops;
+  const std::vector<std::int32_t>& offset;  // first index of each loop in the concatenation
+  SectionTriangulator method;
+  const ForbiddenDiagonals& forbidden;
+
+  SectionTriangulation triangulate(const std::vector<std::size_t>& group,
+                                   std::vector<std::int32_t>& global) const {
+    std::vector<std::vector<Eigen::Vector2d>> subset;
+    std::vector<std::int32_t> local(std::size_t(offset.back()), -1);
+    global.clear();
+    for (const std::size_t l : group) {
+      subset.push_back(loops[l]);
+      for (std::int32_t i = offset[l]; i < offset[l + 1]; ++i) {
+        local[std::size_t(i)] = std::int32_t(global.size());
+        global.push_back(i);
+      }
+    }
+    ForbiddenDiagonals kept;
+    for (const auto& [a, b] : forbidden)
+      if (local[std::size_t(a)] >= 0 && local[std::size_t(b)] >= 0)
+        kept.push_back({local[std::size_t(a)], local[std::size_t(b)]});
+    return triangulate_section(subset, method, kept);
+  }
+};
+
+}  // namespace
+
+OrientedSections oriented_sections(const std::vector<std::vector<Eigen::Vector2d>>& loops,
+                                   SectionTriangulator method,
+                                   const ForbiddenDiagonals& forbidden) {
+  std::vector<std::int32_t> offset(loops.size() + 1, 0);
+  std::vector<bool> counter_clockwise(loops.size());
+  for (std::size_t l = 0; l < loops.size(); ++l) {
+    offset[l + 1] = offset[l] + std::int32_t(loops[l].size());
+    counter_clockwise[l] = signed_area(loops[l]) > 0;
+  }
+  const GroupSection sections{loops, offset, method, forbidden};
+  OrientedSections out;
+  std::vector<std::size_t> pending(loops.size());
+  std::iota(pending.begin(), pending.end(), std::size_t(0));
+  std::vector<std::int32_t> global;
+  // Each round caps a group (its outermost loops always stay in it), so this ends.
+  while (!pending.empty()) {
+    std::vector<std::size_t> group = pending, deferred;
+    SectionTriangulation section;
+    while (!group.empty()) {
+      section = sections.triangulate(group, global);
+      if (!section.ok()) {
+        OrientedSections failed;
+        failed.problem = section.problem;
+        return failed;
+      }
+      std::vector<std::size_t> agree;
+      for (std::size_t k = 0; k < group.size(); ++k) {
+        const bool even = section.depth[k] % 2 == 0;
+        // An outermost loop is kept either way (an inside-out surface is capped as before).
+        if (counter_clockwise[group[k]] == even || section.depth[k] == 0)
+          agree.push_back(group[k]);
+        else
+          deferred.push_back(group[k]);
+      }
+      if (agree.size() == group.size()) break;
+      group = std::move(agree);
+    }
+    if (!group.empty()) {
+      for (const auto& t : section.triangles)
+        out.triangles.push_back(
+            {global[std::size_t(t[0])], global[std::size_t(t[1])], global[std::size_t(t[2])]});
+      out.capped_loops += std::int32_t(group.size());
+      for (const auto d : section.depth) out.nested_loops += d > 0;
+    }
+    pending = std::move(deferred);
+  }
+  return out;
+}
+
+}  // namespace conform::mesh::detail
