@@ -87,8 +87,9 @@ struct Work {
     adjacency = m.adjacency;
     index = m.index;
   }
-  Tear tear(int mode) {
+  Tear tear(int mode, bool smooth_lips = false) {
     TearOptions o;
+    o.smooth_lips = smooth_lips;
     return mode == 0 ? Tear(mesh, adjacency, index, o) : Tear(mesh, adjacency, o);
   }
   DrillResult drill(int mode, const DrillTool& tool, bool tube, double rings = 0) {
@@ -159,15 +160,16 @@ void tear_step(benchmark::State& state, int faces, int mode) {
   speedup(state, kPaperTearSeconds, total);
 }
 
-// A whole 100-sample stroke (the first sample finds the blade's hit: index query or scan).
-void tear100(benchmark::State& state, int faces, int mode) {
+// A whole 100-sample stroke (the first sample finds the blade's hit: index query or scan);
+// smooth_lips (issue 18's lips, as tear-opening tears) against the default tear, its baseline.
+void tear100(benchmark::State& state, int faces, int mode, bool smooth_lips = false) {
   const Model& m = model(faces);
   Workbench bench{m, false, {}};
   int steps = 0;
   std::int32_t split = 0;
   double total = 0;
   auto stroke = [&](Work& w) {
-    Tear tear = w.tear(mode);
+    Tear tear = w.tear(mode, smooth_lips);
     split = 0;
     for (int i = 0; i < 100; ++i) split += removed_faces(tear.advance(arm_blade(i, 100)).changes);
     steps = tear.steps();
@@ -276,6 +278,12 @@ void register_all() {
           ->UseManualTime()
           ->Unit(benchmark::kMillisecond)
           ->Iterations(faces >= 500000 ? 3 : 10);
+      if (mode == 0)
+        benchmark::RegisterBenchmark(("BM_Tear100Lips" + tail).c_str(),
+                                     [=](benchmark::State& s) { tear100(s, faces, mode, true); })
+            ->UseManualTime()
+            ->Unit(benchmark::kMillisecond)
+            ->Iterations(faces >= 500000 ? 3 : 10);
       for (int variant = 0; variant < 3; ++variant) {
         const char* name[] = {"BM_Drill", "BM_DrillTube", "BM_DrillTubeRings"};
         benchmark::RegisterBenchmark((name[variant] + tail).c_str(),

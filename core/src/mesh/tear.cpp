@@ -175,6 +175,33 @@ std::array<double, 3> place_tip(const std::array<double, 3>& bary, const Eigen::
   return best;
 }
 
+// Step 6's direction at each interior path point: Π's normal of the step that made it (toward
+// the left side) without its component along the path, averaged with its neighbours'. Π
+// leans along the path where the tip was off the blade's track, and an opening along it moves
+// a point past its neighbours (lips that zigzag).
+std::vector<Eigen::Vector3d> opening_directions(const std::vector<Eigen::Vector3d>& points,
+                                                const std::vector<Eigen::Vector3d>& normals) {
+  const std::size_t n = points.size();
+  std::vector<Eigen::Vector3d> across(normals);
+  auto tangent = [&](std::size_t i) {
+    return Eigen::Vector3d(points[std::min(i + 1, n - 1)] - points[i > 0 ? i - 1 : 0]).normalized();
+  };
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    const Eigen::Vector3d t = tangent(i);
+    if (t.allFinite()) across[i] -= across[i].dot(t) * t;
+  }
+  std::vector<Eigen::Vector3d> out(normals);
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    Eigen::Vector3d d = 2 * across[i];
+    if (i > 1) d += across[i - 1];
+    if (i + 2 < n) d += across[i + 1];
+    const Eigen::Vector3d t = tangent(i);
+    if (t.allFinite()) d -= d.dot(t) * t;
+    if (d.norm() > 1e-6 * across[i].norm() && d.allFinite()) out[i] = d.normalized();
+  }
+  return out;
+}
+
 }  // namespace
 
 // One sample of Tear::advance after the start: steps 1–3 of tear.hpp over the tear's state.
@@ -499,11 +526,25 @@ class TearAdvance {
   bool split_along_path() {
     split_.base_vertex_count = nv0_ = mesh_.vertex_count();
     split_.base_face_count = mesh_.face_count();
-    points_.push_back(tear_.tip_);
-    target_ = tear_.tip_target_;
-    for (Crossing& c : path_) {
-      if (c.out.kind == PathPoint::Inside && !place_new_tip(c)) return false;
-      split_face(c);
+    const bool smooth = tear_.options_.smooth_lips;
+    const PathPoint blade = path_.back().out;
+    if (!(smooth && split_with_tip_on_edge(kLipBehind))) {
+      restart_split();
+      points_.push_back(tear_.tip_);
+      for (std::size_t i = 0; i < path_.size(); ++i) {
+        Crossing& c = path_[i];
+        if (c.out.kind == PathPoint::Inside && !place_new_tip(c)) {
+          // No room inside the face for a tip: on the edge crossing behind the blade, however
+          // far, or else on the one ahead, where that makes no sliver.
+          const std::string message = tear_.message_;
+          path_.back().out = blade;
+          if (smooth && split_with_tip_on_edge(std::numeric_limits<double>::infinity(), true))
+            break;
+          tear_.message_ = message;
+          return false;
+        }
+        split_face(c);
+      }
     }
     std::sort(split_.removed_faces.begin(), split_.removed_faces.end());
     split_.removed_faces.erase(
@@ -511,6 +552,119 @@ class TearAdvance {
         split_.removed_faces.end());
     tear_.commit(std::move(split_), step_);
     return true;
+  }
+
+  void restart_split() {
+    split_.new_vertices.clear();
+    split_.removed_faces.clear();
+    split_.added_faces.clear();
+    edge_ids_ = EdgeMap();
+    points_.clear();
+    tip_id_ = -1;
+    target_ = tear_.tip_target_;
+  }
+
+  double mean_edge(std::int32_t face) const {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    double sum = 0;
+    for (int k = 0; k < 3; ++k)
+      sum += (mesh_.current.col(f[(k + 1) % 3]) - mesh_.current.col(f[k])).norm();
+    return sum / 3;
+  }
+
+  // The lips' spacing (TearOptions::smooth_lips): a blade hit just past the last edge crossing
+  // (within `behind` of the face's mean edge, kLipBehind) leaves the new tip on that crossing,
+  // and the blade's face is split from its vertex opposite that edge. A tip inside the face
+  // would make a pair of path points that close, and a fan of thin triangles on the face's far
+  // vertex; the tip lags the blade by at most that much. With `ahead`, a hit too far from the
+  // crossing (or one in a face beside the tip) puts the tip where Π leaves the blade's face
+  // instead, and splits the face beyond. False (nothing kept) when neither applies or the
+  // faces it makes would be thinner than min_angle.
+  static constexpr double kLipBehind = 0.4;
+  bool split_with_tip_on_edge(double behind, bool ahead = false) {
+    const Crossing& last = path_.back();
+    if (last.out.kind != PathPoint::Inside || !roomy(last.face)) return false;
+    const Eigen::Vector3d hit = pos(last.out, last.face);
+    std::vector<Crossing> path = path_;
+    PathPoint tip;
+    std::int32_t beyond = -1;  // the face split from the tip: not on the rest of the walk
+    if (path.size() >= 2 && last.in.kind == PathPoint::Edge &&
+        (hit - pos(last.in, last.face)).norm() < behind * mean_edge(last.face)) {
+      tip = last.in;
+      beyond = last.face;
+      path.pop_back();  // the path ends at the tip
+    } else if (ahead && exit_ahead(last, hit, tip)) {
+      path.back().out = tip;
+      const std::int32_t e = adjacency_.find(tip.a, tip.b), g = adjacency_.find(tip.b, tip.a);
+      const std::int32_t o = e >= 0 && e / 3 == last.face ? g : e;
+      if (o < 0) return false;  // a boundary edge
+      beyond = o / 3;
+    } else {
+      return false;
+    }
+    restart_split();
+    points_.push_back(tear_.tip_);
+    std::size_t first_checked = 0;  // the faces beside the tip, which differ from an inside tip's
+    for (std::size_t i = 0; i < path.size(); ++i) {
+      if (i + 1 == path.size() && path.size() == path_.size())
+        first_checked = split_.added_faces.size();
+      split_face(path[i]);
+    }
+    if (path.size() < path_.size()) first_checked = split_.added_faces.size();
+    if (std::find(split_.removed_faces.begin(), split_.removed_faces.end(), beyond) !=
+        split_.removed_faces.end())
+      return false;
+    split_from_opposite(beyond, tip);
+    const double floor2 = std::pow(std::sin(tear_.options_.min_angle), 2);
+    for (std::size_t i = first_checked; i < split_.added_faces.size(); ++i) {
+      const Face& f = split_.added_faces[i];
+      if (smallest_angle_sin2(position_of(f[0]), position_of(f[1]), position_of(f[2])) < floor2)
+        return false;
+    }
+    path_ = std::move(path);
+    target_ = hit;
+    return true;
+  }
+
+  // A face whose corners, split once more, keep the sliver floor (smallest angle ≥ 2 min_angle):
+  // in a thinner face (a real model's) the halves would be split again below the bound of the
+  // face they lie in (mesh_real_models_test found one without this check).
+  bool roomy(std::int32_t face) const {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    return smallest_angle(mesh_.current.col(f[0]), mesh_.current.col(f[1]),
+                          mesh_.current.col(f[2])) >= 2 * tear_.options_.min_angle;
+  }
+
+  // Where Π leaves the blade's face (crossing c) ahead of the hit, on an edge other than the
+  // one it came in by: false if there is none (or Π leaves it through a vertex).
+  bool exit_ahead(const Crossing& c, const Eigen::Vector3d& hit, PathPoint& out) const {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
+    const Eigen::Vector3d from = pos(c.in, c.face);
+    for (int corner = 0; corner < 3; ++corner) {
+      const std::int32_t x = f[(corner + 1) % 3], y = f[(corner + 2) % 3];
+      if (on_edge(c.in, x, y) || (c.in.kind == PathPoint::Vertex && (c.in.v == x || c.in.v == y)))
+        continue;
+      PathPoint e;
+      if (!exit_opposite(c.face, corner, e) || e.kind != PathPoint::Edge) continue;
+      if ((pos(e, c.face) - hit).dot(hit - from) <= 0) continue;
+      out = e;
+      return true;
+    }
+    return false;
+  }
+
+  // Face `face`, which holds edge point p's edge, split in two from its vertex opposite it.
+  void split_from_opposite(std::int32_t face, const PathPoint& p) {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    const std::int32_t mid = id_of(p, face);
+    for (int k = 0; k < 3; ++k)
+      if (on_edge(p, f[k], f[(k + 1) % 3])) {
+        const std::int32_t x = f[k], y = f[(k + 1) % 3], z = f[(k + 2) % 3];
+        split_.removed_faces.push_back(face);
+        split_.added_faces.push_back({x, mid, z});
+        split_.added_faces.push_back({mid, y, z});
+        return;
+      }
   }
 
   // The new tip in crossing c's face, moved so that its fan makes no sliver.
@@ -816,12 +970,19 @@ std::vector<std::pair<std::int32_t, Eigen::Vector3d>> Tear::open(double amount) 
   std::vector<std::pair<std::int32_t, Eigen::Vector3d>> out;
   const double total = length();
   if (path_.size() < 3 || !(total > 0) || amount == 0) return out;
+  std::vector<Eigen::Vector3d> direction;
+  for (const auto& p : path_) direction.push_back(p.normal);
+  if (options_.smooth_lips) {
+    std::vector<Eigen::Vector3d> points;
+    for (const auto& p : path_) points.push_back(mesh_.current.col(p.right));
+    direction = opening_directions(points, direction);
+  }
   std::vector<Eigen::Vector3d> delta(path_.size(), Eigen::Vector3d::Zero());
   double s = 0;
   for (std::size_t i = 1; i + 1 < path_.size(); ++i) {
     s += (mesh_.current.col(path_[i].right) - mesh_.current.col(path_[i - 1].right)).norm();
     if (path_[i].left < 0) continue;
-    delta[i] = 0.5 * amount * std::sin(std::numbers::pi * s / total) * path_[i].normal;
+    delta[i] = 0.5 * amount * std::sin(std::numbers::pi * s / total) * direction[i];
   }
   for (std::size_t i = 1; i + 1 < path_.size(); ++i) {
     if (path_[i].left < 0) continue;
