@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <string>
@@ -113,6 +114,162 @@ std::pair<std::int32_t, std::int32_t> boundary_edge(const cb::SkinnedSoftBody& b
   return {-1, -1};
 }
 
+// A kinematic rigid-body scalpel along the upper arm, 2.5 mm per frame.
+void tear_with_rigid_scalpel(World& app, cb::Plugin& plugin, cb::SkinnedSoftBody& arm) {
+  btRigidBody& blade = app.add_box({0.075f, 0.001f, 0.001f}, {0.075f, 0, 0.08f}, 0, 0, 0);
+  blade.setCollisionFlags(blade.getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+  blade.setActivationState(DISABLE_DEACTIVATION);
+  cb::RigidScalpel scalpel(arm, blade, {-0.075f, 0, 0}, {0.075f, 0, 0});
+  for (int i = 0; i <= 48; ++i) {
+    blade.setWorldTransform(btTransform(btQuaternion::getIdentity(),
+                                        btVector3(0.075f, 0, btScalar(0.08 + 0.0025 * i))));
+    app.step(1);
+    scalpel.update(plugin.time());
+  }
+  check(arm.tear() && arm.tear()->length() > 0.08, "the scalpel tore the upper arm (m)",
+        arm.tear() ? arm.tear()->length() : 0);
+  std::printf("application: scalpel: %d samples, %d extended, %d held, h %.4f, message '%s'\n",
+              scalpel.totals().samples, scalpel.totals().extended, scalpel.totals().held,
+              scalpel.edge_length(), arm.tear() ? arm.tear()->message().c_str() : "");
+  check(scalpel.totals().extended >= 0.8 * scalpel.totals().samples,
+        "scalpel samples that extended the tear (fraction)",
+        double(scalpel.totals().extended) / std::max(1, scalpel.totals().samples));
+}
+
+// Cut the hand off (capped: a closed piece) and release it onto the ground box.
+void cut_and_release_hand(World& app, cb::SkinnedSoftBody& arm, std::vector<cb::PieceEvent>& events,
+                          double arm_mass) {
+  events.clear();
+  const cb::PieceId whole = arm.piece_of(0);
+  conform::mesh::CutOptions capped{};
+  capped.cap = true;
+  const auto cut =
+      arm.cut(conform::cga::Plane<double>::from_normal_point({0, 0, 1}, {0, 0, 0.5}), capped);
+  check(cut.status == conform::mesh::CutStatus::Cut && cut.capped_loops == cut.loops,
+        "capped cut of the forearm (loops)", cut.loops);
+  check(std::abs(arm.total_mass() - arm_mass) < 1e-9 * arm_mass, "mass kept by tear and cut (kg)",
+        arm.total_mass());
+  // The renderer's view of the cut: its cap faces (both sides) tagged cap, by this change.
+  std::int32_t cap_faces = 0;
+  for (const auto& tag : arm.face_tags())
+    cap_faces += tag.kind == conform::mesh::FaceKind::cap && tag.op == arm.mesh().edits;
+  check(cap_faces == 2 * cut.cap_faces, "face tags: the cut's cap faces (faces)", cap_faces);
+  cb::PieceId hand{};
+  for (std::int32_t v = 0; v < arm.vertex_count(); ++v)
+    if (arm.position(v).z() > 0.6) hand = arm.piece_of(v);
+  check(events.size() == 1 && events[0].kind == cb::PieceEvent::Kind::created &&
+            events[0].piece == hand && events[0].parent == whole,
+        "event: the hand piece created, parent the arm (events)", double(events.size()));
+  cb::ReleaseOptions release{};
+  release.volume_modulus = 100;  // Pa: the hollow piece keeps its volume
+  arm.release_piece(hand, release);
+  double worst_inside = 0;
+  for (int frame = 0; frame < 90; ++frame) {
+    app.step(1);
+    const btSoftBody& sb = *arm.piece_body(hand);
+    for (int i = 0; i < sb.m_nodes.size(); ++i)
+      worst_inside = std::max(worst_inside, inside_ground(sb.m_nodes[i].m_x));
+  }
+  double lowest = 1e9;
+  for (int i = 0; i < arm.piece_body(hand)->m_nodes.size(); ++i)
+    lowest = std::min(lowest, double(arm.piece_body(hand)->m_nodes[i].m_x.y()));
+  check(lowest < kGroundTop + 0.02 && lowest > kGroundTop - 1e-3,
+        "the released hand landed on the ground box (lowest y, m)", lowest);
+  check(worst_inside <= 1e-3, "no hand node ever more than 1 mm inside the box (m)", worst_inside);
+}
+
+// A handle kept across the edit that empties its piece: the IK arm cut in two, then a face
+// bridging the pieces merges the smaller one into the larger (its body is deleted). False when
+// the set-up itself failed (already reported).
+bool empty_a_piece_behind_its_handle(cb::SkinnedSoftBody& ik_arm,
+                                     std::vector<cb::PieceEvent>& events) {
+  // The plane: across the upper arm as it is now (its joints placed in the world).
+  const auto now = ik_arm.joint_transforms();
+  const Eigen::Vector3d shoulder = ik_arm.world_transform() *
+                                   Eigen::Vector3d(now[0].apply(Eigen::Vector3d::Zero())),
+                        elbow = ik_arm.world_transform() *
+                                Eigen::Vector3d(now[1].apply(Eigen::Vector3d::Zero()));
+  ik_arm.cut(conform::cga::Plane<double>::from_normal_point(elbow - shoulder,
+                                                            shoulder + 0.5 * (elbow - shoulder)));
+  const auto ids = ik_arm.piece_ids();
+  check(ids.size() >= 2, "the IK arm cut in pieces (pieces)", double(ids.size()));
+  if (ids.size() < 2) return false;
+  cb::PieceId smaller = ids.front(), larger = ids.back();
+  if (ik_arm.piece_body(smaller)->m_nodes.size() > ik_arm.piece_body(larger)->m_nodes.size())
+    std::swap(smaller, larger);
+  const auto [a, b] = boundary_edge(ik_arm, smaller);
+  check(a >= 0, "a boundary edge of the smaller piece", a);
+  if (a < 0) return false;
+  std::int32_t c = -1;
+  double nearest = 1e9;
+  for (std::int32_t v = 0; v < ik_arm.vertex_count(); ++v) {
+    const double d = (ik_arm.position(v) - ik_arm.position(a)).norm();
+    if (ik_arm.piece_of(v) == larger && d > 1e-6 && d < nearest) nearest = d, c = v;
+  }
+  events.clear();
+  ik_arm.sync_mesh();
+  conform::mesh::TopologyChange bridge;
+  bridge.base_vertex_count = ik_arm.vertex_count();
+  bridge.base_face_count = std::int32_t(ik_arm.mesh().faces.size());
+  bridge.added_faces.push_back({b, a, c});
+  ik_arm.apply(bridge);
+  check(events.size() == 1 && events[0].kind == cb::PieceEvent::Kind::removed &&
+            events[0].piece == smaller,
+        "event: the emptied piece removed (events)", double(events.size()));
+  check(!ik_arm.piece_valid(smaller) && ik_arm.piece_body(smaller) == nullptr,
+        "its kept handle is stale, its body null", 0);
+
+  return true;
+}
+
+// The IK arm keeps tracking; the character keeps playing; the boxes lie on the ground.
+void check_the_scene_goes_on(World& app, const cb::SkinnedSoftBody& ik_arm,
+                             const cb::SkinnedSoftBody& character,
+                             std::initializer_list<btRigidBody*> boxes) {
+  app.step(20);
+  const auto joints = ik_arm.joint_transforms();
+  const Eigen::Vector3d wrist =
+      ik_arm.world_transform() * Eigen::Vector3d(joints[2].apply(Eigen::Vector3d::Zero()));
+  const Eigen::Vector3d target = Eigen::Vector3d(2, 0, 0) + ik_target(ik_arm.clock_time());
+  check((wrist - target).norm() < 1e-9, "IK arm's wrist on its target (m)",
+        (wrist - target).norm());
+  double off_target = 0;
+  bool finite = true;
+  for (std::int32_t v = 0; v < character.vertex_count(); ++v) {
+    finite = finite && character.position(v).allFinite();
+    if (character.kinematic(v))
+      off_target = std::max(off_target, (character.position(v) - character.target(v)).norm());
+  }
+  check(finite && off_target < 1e-4 * (1 + character.target(0).norm()),
+        "the character's kinematic nodes on their animated targets", off_target);
+  check(character.clock_time() > 2.0, "the character's animation clock (s)",
+        character.clock_time());
+  for (btRigidBody* box : boxes) {
+    const double y = double(box->getWorldTransform().getOrigin().y());
+    check(std::abs(y - (kGroundTop + 0.025)) < 0.005, "a rigid box rests on the ground (y, m)", y);
+  }
+}
+
+// Bullet's standard teardown (remove and delete every soft body, then the plugin, the world)
+// or the world destroyed first.
+void tear_down(std::unique_ptr<World>& app, std::unique_ptr<cb::Plugin>& plugin, bool world_first) {
+  if (world_first) {
+    app->world.reset();  // the world (and Bullet's soft bodies' world) first, then the plugin
+    plugin.reset();
+  } else {  // Bullet's standard: remove and delete every soft body, then the plugin, the world
+    auto& softs = app->world->getSoftBodyArray();
+    while (softs.size() > 0) {
+      btSoftBody* sb = softs[softs.size() - 1];
+      app->world->removeSoftBody(sb);
+      delete sb;
+    }
+    for (auto& r : app->rigid) app->world->removeRigidBody(r.get());
+    plugin.reset();
+    app->world.reset();
+  }
+  std::printf("application: teardown finished\n");
+}
+
 void run(const std::string& model_file, bool world_first) {
   std::printf("application: --- teardown: %s ---\n",
               world_first ? "world destroyed before the plugin" : "Bullet's standard");
@@ -151,143 +308,11 @@ void run(const std::string& model_file, bool world_first) {
   const double arm_mass = arm.total_mass();
   app->step(10);
 
-  // A kinematic rigid-body scalpel along the upper arm, 2.5 mm per frame.
-  btRigidBody& blade = app->add_box({0.075f, 0.001f, 0.001f}, {0.075f, 0, 0.08f}, 0, 0, 0);
-  blade.setCollisionFlags(blade.getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
-  blade.setActivationState(DISABLE_DEACTIVATION);
-  cb::RigidScalpel scalpel(arm, blade, {-0.075f, 0, 0}, {0.075f, 0, 0});
-  for (int i = 0; i <= 48; ++i) {
-    blade.setWorldTransform(btTransform(btQuaternion::getIdentity(),
-                                        btVector3(0.075f, 0, btScalar(0.08 + 0.0025 * i))));
-    app->step(1);
-    scalpel.update(plugin->time());
-  }
-  check(arm.tear() && arm.tear()->length() > 0.08, "the scalpel tore the upper arm (m)",
-        arm.tear() ? arm.tear()->length() : 0);
-  std::printf("application: scalpel: %d samples, %d extended, %d held, h %.4f, message '%s'\n",
-              scalpel.totals().samples, scalpel.totals().extended, scalpel.totals().held,
-              scalpel.edge_length(), arm.tear() ? arm.tear()->message().c_str() : "");
-  check(scalpel.totals().extended >= 0.8 * scalpel.totals().samples,
-        "scalpel samples that extended the tear (fraction)",
-        double(scalpel.totals().extended) / std::max(1, scalpel.totals().samples));
-
-  // Cut the hand off (capped: a closed piece) and release it onto the ground box.
-  events.clear();
-  const cb::PieceId whole = arm.piece_of(0);
-  conform::mesh::CutOptions capped{};
-  capped.cap = true;
-  const auto cut =
-      arm.cut(conform::cga::Plane<double>::from_normal_point({0, 0, 1}, {0, 0, 0.5}), capped);
-  check(cut.status == conform::mesh::CutStatus::Cut && cut.capped_loops == cut.loops,
-        "capped cut of the forearm (loops)", cut.loops);
-  check(std::abs(arm.total_mass() - arm_mass) < 1e-9 * arm_mass, "mass kept by tear and cut (kg)",
-        arm.total_mass());
-  // The renderer's view of the cut: its cap faces (both sides) tagged cap, by this change.
-  std::int32_t cap_faces = 0;
-  for (const auto& tag : arm.face_tags())
-    cap_faces += tag.kind == conform::mesh::FaceKind::cap && tag.op == arm.mesh().edits;
-  check(cap_faces == 2 * cut.cap_faces, "face tags: the cut's cap faces (faces)", cap_faces);
-  cb::PieceId hand{};
-  for (std::int32_t v = 0; v < arm.vertex_count(); ++v)
-    if (arm.position(v).z() > 0.6) hand = arm.piece_of(v);
-  check(events.size() == 1 && events[0].kind == cb::PieceEvent::Kind::created &&
-            events[0].piece == hand && events[0].parent == whole,
-        "event: the hand piece created, parent the arm (events)", double(events.size()));
-  cb::ReleaseOptions release{};
-  release.volume_modulus = 100;  // Pa: the hollow piece keeps its volume
-  arm.release_piece(hand, release);
-  double worst_inside = 0;
-  for (int frame = 0; frame < 90; ++frame) {
-    app->step(1);
-    const btSoftBody& sb = *arm.piece_body(hand);
-    for (int i = 0; i < sb.m_nodes.size(); ++i)
-      worst_inside = std::max(worst_inside, inside_ground(sb.m_nodes[i].m_x));
-  }
-  double lowest = 1e9;
-  for (int i = 0; i < arm.piece_body(hand)->m_nodes.size(); ++i)
-    lowest = std::min(lowest, double(arm.piece_body(hand)->m_nodes[i].m_x.y()));
-  check(lowest < kGroundTop + 0.02 && lowest > kGroundTop - 1e-3,
-        "the released hand landed on the ground box (lowest y, m)", lowest);
-  check(worst_inside <= 1e-3, "no hand node ever more than 1 mm inside the box (m)", worst_inside);
-
-  // A handle kept across the edit that empties its piece: the IK arm cut in two, then a face
-  // bridging the pieces merges the smaller one into the larger (its body is deleted).
-  // The plane: across the upper arm as it is now (its joints placed in the world).
-  const auto now = ik_arm.joint_transforms();
-  const Eigen::Vector3d shoulder = ik_arm.world_transform() *
-                                   Eigen::Vector3d(now[0].apply(Eigen::Vector3d::Zero())),
-                        elbow = ik_arm.world_transform() *
-                                Eigen::Vector3d(now[1].apply(Eigen::Vector3d::Zero()));
-  ik_arm.cut(conform::cga::Plane<double>::from_normal_point(elbow - shoulder,
-                                                            shoulder + 0.5 * (elbow - shoulder)));
-  const auto ids = ik_arm.piece_ids();
-  check(ids.size() >= 2, "the IK arm cut in pieces (pieces)", double(ids.size()));
-  if (ids.size() < 2) return;
-  cb::PieceId smaller = ids.front(), larger = ids.back();
-  if (ik_arm.piece_body(smaller)->m_nodes.size() > ik_arm.piece_body(larger)->m_nodes.size())
-    std::swap(smaller, larger);
-  const auto [a, b] = boundary_edge(ik_arm, smaller);
-  check(a >= 0, "a boundary edge of the smaller piece", a);
-  if (a < 0) return;
-  std::int32_t c = -1;
-  double nearest = 1e9;
-  for (std::int32_t v = 0; v < ik_arm.vertex_count(); ++v) {
-    const double d = (ik_arm.position(v) - ik_arm.position(a)).norm();
-    if (ik_arm.piece_of(v) == larger && d > 1e-6 && d < nearest) nearest = d, c = v;
-  }
-  events.clear();
-  ik_arm.sync_mesh();
-  conform::mesh::TopologyChange bridge;
-  bridge.base_vertex_count = ik_arm.vertex_count();
-  bridge.base_face_count = std::int32_t(ik_arm.mesh().faces.size());
-  bridge.added_faces.push_back({b, a, c});
-  ik_arm.apply(bridge);
-  check(events.size() == 1 && events[0].kind == cb::PieceEvent::Kind::removed &&
-            events[0].piece == smaller,
-        "event: the emptied piece removed (events)", double(events.size()));
-  check(!ik_arm.piece_valid(smaller) && ik_arm.piece_body(smaller) == nullptr,
-        "its kept handle is stale, its body null", 0);
-
-  // The IK arm keeps tracking; the character keeps playing; the boxes lie on the ground.
-  app->step(20);
-  const auto joints = ik_arm.joint_transforms();
-  const Eigen::Vector3d wrist =
-      ik_arm.world_transform() * Eigen::Vector3d(joints[2].apply(Eigen::Vector3d::Zero()));
-  const Eigen::Vector3d target = Eigen::Vector3d(2, 0, 0) + ik_target(ik_arm.clock_time());
-  check((wrist - target).norm() < 1e-9, "IK arm's wrist on its target (m)",
-        (wrist - target).norm());
-  double off_target = 0;
-  bool finite = true;
-  for (std::int32_t v = 0; v < character.vertex_count(); ++v) {
-    finite = finite && character.position(v).allFinite();
-    if (character.kinematic(v))
-      off_target = std::max(off_target, (character.position(v) - character.target(v)).norm());
-  }
-  check(finite && off_target < 1e-4 * (1 + character.target(0).norm()),
-        "the character's kinematic nodes on their animated targets", off_target);
-  check(character.clock_time() > 2.0, "the character's animation clock (s)",
-        character.clock_time());
-  for (btRigidBody* box : {&box1, &box2}) {
-    const double y = double(box->getWorldTransform().getOrigin().y());
-    check(std::abs(y - (kGroundTop + 0.025)) < 0.005, "a rigid box rests on the ground (y, m)", y);
-  }
-
-  // Teardown.
-  if (world_first) {
-    app->world.reset();  // the world (and Bullet's soft bodies' world) first, then the plugin
-    plugin.reset();
-  } else {  // Bullet's standard: remove and delete every soft body, then the plugin, the world
-    auto& softs = app->world->getSoftBodyArray();
-    while (softs.size() > 0) {
-      btSoftBody* sb = softs[softs.size() - 1];
-      app->world->removeSoftBody(sb);
-      delete sb;
-    }
-    for (auto& r : app->rigid) app->world->removeRigidBody(r.get());
-    plugin.reset();
-    app->world.reset();
-  }
-  std::printf("application: teardown finished\n");
+  tear_with_rigid_scalpel(*app, *plugin, arm);
+  cut_and_release_hand(*app, arm, events, arm_mass);
+  if (!empty_a_piece_behind_its_handle(ik_arm, events)) return;
+  check_the_scene_goes_on(*app, ik_arm, character, {&box1, &box2});
+  tear_down(app, plugin, world_first);
 }
 
 }  // namespace
