@@ -57,17 +57,28 @@ detail::ElementState state_of(const Model& model, const Triangle& t) {
 constexpr std::array<std::array<double, 2>, 6> kCases = {
     {{1.04, 1.03}, {1.1, 0.98}, {1.05, 0.75}, {0.8, 1.02}, {0.7, 0.72}, {0.6, 0.8}}};
 
+// Trial `trial`'s triangle (cycling through kCases), its element and its relaxed state.
+struct Sample {
+  Triangle t;
+  Model model;
+  detail::ElementState s;
+  Sample(std::mt19937& rng, int trial) {
+    const auto c = kCases[std::size_t(trial) % kCases.size()];
+    t = deformed_triangle(rng, c[0], c[1]);
+    model.build(t.rest, t.faces, anisotropic());
+    s = state_of(model, t);
+  }
+};
+
 TEST(MembraneWrinkling, RelaxedEnergyIsTheMinimumOverWrinkleStrains) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-1, 1);
   int seen[3] = {0, 0, 0};
   for (int trial = 0; trial < 60; ++trial) {
-    const auto c = kCases[std::size_t(trial) % kCases.size()];
-    const Triangle t = deformed_triangle(rng, c[0], c[1]);
-    Model model;
-    model.build(t.rest, t.faces, anisotropic());
+    const Sample sample(rng, trial);
+    const Model& model = sample.model;
     const detail::ElementRest& e = model.elements()[0];
-    const detail::ElementState s = state_of(model, t);
+    const detail::ElementState& s = sample.s;
     ++seen[int(s.regime)];
     const Eigen::Matrix2d strain = detail::green_strain(s.f);
     const double plain = detail::energy_density(e, strain, model.lambda(), model.mu());
@@ -104,12 +115,11 @@ TEST(MembraneWrinkling, GradientAndHessianAreTheDerivativesInEveryRegime) {
   std::mt19937 rng(9);
   int seen[3] = {0, 0, 0};
   for (int trial = 0; trial < 60; ++trial) {
-    const auto c = kCases[std::size_t(trial) % kCases.size()];
-    const Triangle t = deformed_triangle(rng, c[0], c[1]);
-    Model model;
-    model.build(t.rest, t.faces, anisotropic());
+    const Sample sample(rng, trial);
+    const Triangle& t = sample.t;
+    const Model& model = sample.model;
     const detail::ElementRest& e = model.elements()[0];
-    const detail::ElementState s = state_of(model, t);
+    const detail::ElementState& s = sample.s;
     ++seen[int(s.regime)];
     Eigen::Matrix3Xd g(3, 3);
     model.gradient(t.x, g);
