@@ -7,6 +7,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "drill_pinch.hpp"
 #include "drill_region.hpp"
 #include "drill_rim.hpp"
 #include "drill_tube.hpp"
@@ -279,6 +280,47 @@ TopologyChange start_change(Region& region, const SkinnedMesh& mesh, bool tube,
   return ch;
 }
 
+// Steps 5–5b: the clipping and the change's vertices and removed faces, clipped again without
+// each rim vertex it would pinch (drill_pinch.hpp), un-snapped back to its own side of the
+// cylinder. Every round un-snaps at least one vertex for good, so the rounds end. False when
+// the drill removes nothing.
+bool clip_unpinched(Region& region, std::vector<Patch>& patches, const SkinnedMesh& mesh,
+                    const Adjacency& adjacency, const Axis& axis, bool tube, DrillResult& result,
+                    TopologyChange& ch) {
+  // What the clipping and start_change write, to start each round from.
+  const std::size_t verts_before = region.verts.size();
+  std::vector<bool> modified_before;
+  for (const auto& o : region.origins) modified_before.push_back(o.modified);
+  const std::vector<Patch> patches_before = patches;
+  const DrillResult result_before = result;
+  int unsnapped = 0;
+  for (;;) {
+    Clipper(region, patches, axis, result).run();
+    for (const auto& p : patches) result.holes += p.cut;
+    if (result.holes == 0) return false;
+    ch = start_change(region, mesh, tube, result);
+    const std::vector<std::int32_t> pinched = pinched_rim_vertices(region, mesh, adjacency, ch);
+    if (pinched.empty()) break;
+    for (const std::int32_t v : pinched) {
+      auto& x = region.verts[std::size_t(v)];
+      x.side = region.inside(x.q) ? -1 : 1;
+    }
+    unsnapped += int(pinched.size());
+    region.verts.resize(verts_before);
+    for (auto& v : region.verts)
+      if (v.index >= ch.base_vertex_count) v.index = -1;
+    for (std::size_t o = 0; o < region.origins.size(); ++o)
+      region.origins[o].modified = modified_before[o];
+    patches = patches_before;
+    result = result_before;
+    region.added.clear(), region.hole_edges.clear(), region.new_x.clear();
+    region.crossing_vertex.clear();
+  }
+  result.snapped_rim_vertices -= unsnapped;
+  result.unsnapped_rim_vertices = unsnapped;
+  return true;
+}
+
 // The rim loops, for the tube: per cut patch, the hole's boundary half-edges chained into one
 // loop of rim vertices, in mesh indices (empty when they are not one simple loop).
 void find_rim_loops(Region& region, std::vector<Patch>& patches) {
@@ -350,13 +392,11 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
   std::vector<Patch> patches = find_patches(region, mesh, axis, seeds, hits);
   refine_rim(region, patches, tool, options, result);
   classify_rim(region, patches, mesh, axis, options, result);
-  Clipper(region, patches, axis, result).run();
-  for (const auto& p : patches) result.holes += p.cut;
-  if (result.holes == 0) {
+  TopologyChange ch;
+  if (!clip_unpinched(region, patches, mesh, adjacency, axis, options.tube, result, ch)) {
     result.message = "the drill pierces the surface but removes nothing";
     return result;
   }
-  TopologyChange ch = start_change(region, mesh, options.tube, result);
   if (options.tube) find_rim_loops(region, patches);
   add_faces(region, options.tube, ch);
   // 6. The tube walls join the rims in the same change.
@@ -377,8 +417,7 @@ DrillResult drill_impl(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex* index
 DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, const DrillTool& tool,
                   const DrillOptions& options) {
   check_input(mesh, adjacency, tool);
-  return drill_impl(mesh, adjacency, nullptr, tool, options,
-                    pierced_faces(mesh, nullptr, tool));
+  return drill_impl(mesh, adjacency, nullptr, tool, options, pierced_faces(mesh, nullptr, tool));
 }
 
 DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex& index, const DrillTool& tool,
@@ -386,8 +425,7 @@ DrillResult drill(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex& index, con
   check_input(mesh, adjacency, tool);
   if (!index.matches(mesh))
     throw std::invalid_argument("drill: the face index does not describe this mesh");
-  return drill_impl(mesh, adjacency, &index, tool, options,
-                    pierced_faces(mesh, &index, tool));
+  return drill_impl(mesh, adjacency, &index, tool, options, pierced_faces(mesh, &index, tool));
 }
 
 }  // namespace conform::mesh

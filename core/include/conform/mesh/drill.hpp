@@ -26,7 +26,11 @@
 // for a rim point up to an edge away: a face that would hold a rim chord from one longer than
 // the refinement's limit (on Π) is bisected and the classification made again (with the
 // angle mending below, four times at most, within max_refinements), so that snapped vertices do
-// not lengthen the rim polygon's chords either.
+// not lengthen the rim polygon's chords either. A snapped vertex is kept, so a hole could pass
+// through it twice (a rim running nearly along the surface, an axis close to a limb's own)
+// and leave two fans of faces meeting at it: the change is checked for such pinched rim
+// vertices before it is applied, and each is un-snapped (back to its own side of the cylinder)
+// and the clipping made again, so that a manifold surface stays manifold.
 // Angle guarantee (no slivers): every face the drill adds to the surface has its smallest
 // angle at least min(min_angle, half the smallest angle of the original face it lies
 // in) (the tube walls are exempt, see below). Refinement keeps half (Rivara). Where a piece of a
@@ -117,7 +121,9 @@ struct DrillResult {
   std::int32_t holes = 0;
   std::int32_t rim_vertices = 0;          // new vertices on the cylinder
   std::int32_t snapped_rim_vertices = 0;  // existing vertices taken as rim vertices
-  std::int32_t removed_area_faces = 0;    // faces removed or clipped
+  // Snapped vertices given back to their side of the cylinder: the hole would pinch there.
+  std::int32_t unsnapped_rim_vertices = 0;
+  std::int32_t removed_area_faces = 0;  // faces removed or clipped
   double removed_area = 0;
   int refinements = 0;     // refinement rounds: bisection depth / 2 (two bisections ≈ one 1-to-4)
   std::int32_t tubes = 0;  // hole pairs joined by a tube wall
