@@ -23,9 +23,9 @@
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/face_index.hpp"
 #include "conform/mesh/primitives.hpp"
-#include "conform/skin/procedural_arm.hpp"
 #include "conform/mesh/tear.hpp"
 #include "conform/mesh/topology_change.hpp"
+#include "conform/skin/procedural_arm.hpp"
 
 namespace {
 
@@ -109,6 +109,7 @@ struct Tally {
   int changed = 0;  // operations that changed the mesh
   int tubes = 0;
   int capped = 0;
+  int unsnapped = 0;  // drills that un-snapped a rim vertex the hole would pinch
 };
 
 void random_cut(std::mt19937& rng, const Subject& s, SkinnedMesh& m, Adjacency& adj, Hasher& h,
@@ -173,6 +174,7 @@ void random_drill(std::mt19937& rng, const Subject& s, SkinnedMesh& m, Adjacency
   h.text(r.message);
   tally.changed += !r.changes.empty();
   tally.tubes += r.tubes;
+  tally.unsnapped += r.unsnapped_rim_vertices > 0;
 }
 
 void random_tear(std::mt19937& rng, const Subject& s, SkinnedMesh& m, Adjacency& adj,
@@ -269,13 +271,17 @@ TEST(MeshBehaviourHash, TwoThousandRandomOperations) {
   RecordProperty("changed", tally.changed);
   RecordProperty("tubes", tally.tubes);
   RecordProperty("capped", tally.capped);
+  RecordProperty("unsnapped", tally.unsnapped);
   char hex[32];
   std::snprintf(hex, sizeof hex, "0x%016llx", static_cast<unsigned long long>(h.value()));
   // Recorded on the code before the restructuring of issue 14 (commit 98647a8):
   // 0x0431338af34689ee, unchanged by the restructuring. The tear's walk bound (issue 12) then
   // changed the message of 4 samples that already failed (their walks left the region the
   // blade swept by more than 8 edges); every mesh change is the same: 0xf46e68cfa1d01bdd.
-  EXPECT_EQ(h.value(), 0xf46e68cfa1d01bddull) << "behaviour hash " << hex;
+  // The drill's pinch check (drill_pinch.hpp) then changed the 5 drills that had left a
+  // non-manifold rim vertex (the `unsnapped` tally): 0xf75c5816d4884971.
+  EXPECT_EQ(tally.unsnapped, 5);
+  EXPECT_EQ(h.value(), 0xf75c5816d4884971ull) << "behaviour hash " << hex;
 }
 
 }  // namespace
