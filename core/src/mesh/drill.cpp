@@ -289,7 +289,8 @@ bool clip_unpinched(Region& region, std::vector<Patch>& patches, const SkinnedMe
                     TopologyChange& ch) {
   // What the clipping and start_change write, to start each round from.
   const std::size_t verts_before = region.verts.size();
-  std::vector<bool> modified_before;
+  thread_local std::vector<bool> modified_before;  // kept per thread, as the Region is
+  modified_before.clear();
   for (const auto& o : region.origins) modified_before.push_back(o.modified);
   const std::vector<Patch> patches_before = patches;
   const DrillResult result_before = result;

@@ -15,7 +15,8 @@ struct LinkEdge {
 
 // The number of connected components of a link (few edges: a linear union–find).
 int link_components(const std::vector<std::pair<std::int32_t, std::int32_t>>& edges) {
-  std::vector<std::int32_t> node, parent;
+  thread_local std::vector<std::int32_t> node, parent;  // kept: drills run at haptic rates
+  node.clear(), parent.clear();
   auto id = [&](std::int32_t v) {
     for (std::size_t i = 0; i < node.size(); ++i)
       if (node[i] == v) return std::int32_t(i);
@@ -89,17 +90,19 @@ void rim_links(const Region& region, std::vector<LinkEdge>& links,
 std::vector<std::int32_t> pinched_rim_vertices(const Region& region, const SkinnedMesh& mesh,
                                                const Adjacency& adjacency,
                                                const TopologyChange& ch) {
-  std::vector<LinkEdge> links;
-  std::vector<std::pair<std::int32_t, std::int32_t>> starts;  // (local vertex, mesh face)
+  // The scratch is kept per thread between drills, as the Region is.
+  thread_local std::vector<LinkEdge> links;
+  thread_local std::vector<std::pair<std::int32_t, std::int32_t>> starts;  // (vertex, face)
+  thread_local std::vector<std::int32_t> centres, fan;
+  thread_local std::vector<std::pair<std::int32_t, std::int32_t>> link;
+  links.clear(), starts.clear(), centres.clear();
   rim_links(region, links, starts);
-  std::vector<std::int32_t> centres;
   for (const LinkEdge& l : links) centres.push_back(l.centre);
   for (const auto& s : starts) centres.push_back(s.first);
   std::sort(centres.begin(), centres.end());
   centres.erase(std::unique(centres.begin(), centres.end()), centres.end());
 
-  std::vector<std::int32_t> pinched, fan;
-  std::vector<std::pair<std::int32_t, std::int32_t>> link;
+  std::vector<std::int32_t> pinched;  // empty (no allocation) but where the hole would pinch
   auto next_link = links.begin();
   auto next_start = starts.begin();
   for (const std::int32_t c : centres) {
