@@ -300,6 +300,7 @@ bool clip_unpinched(Region& region, std::vector<Patch>& patches, const SkinnedMe
     for (const auto& p : patches) result.holes += p.cut;
     if (result.holes == 0) return false;
     ch = start_change(region, mesh, tube, result);
+    if (result.snapped_rim_vertices == unsnapped) break;  // no snapped vertex left to pinch at
     const std::vector<std::int32_t> pinched = pinched_rim_vertices(region, mesh, adjacency, ch);
     if (pinched.empty()) break;
     for (const std::int32_t v : pinched) {

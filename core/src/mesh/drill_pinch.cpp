@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "conform/mesh/detail/union_find.hpp"
+
 namespace conform::mesh::drilling {
 
 namespace {
@@ -13,7 +15,7 @@ struct LinkEdge {
   std::int32_t a, b;
 };
 
-// The number of connected components of a link (few edges: a linear union–find).
+// The number of connected components of a link (few nodes: looked up linearly).
 int link_components(const std::vector<std::pair<std::int32_t, std::int32_t>>& edges) {
   thread_local std::vector<std::int32_t> node, parent;  // kept: drills run at haptic rates
   node.clear(), parent.clear();
@@ -23,16 +25,13 @@ int link_components(const std::vector<std::pair<std::int32_t, std::int32_t>>& ed
     node.push_back(v), parent.push_back(std::int32_t(parent.size()));
     return std::int32_t(node.size() - 1);
   };
-  auto root = [&](std::int32_t i) {
-    while (parent[std::size_t(i)] != i) i = parent[std::size_t(i)];
-    return i;
-  };
   for (const auto& [a, b] : edges) {
-    const std::int32_t ra = root(id(a)), rb = root(id(b));
-    if (ra != rb) parent[std::size_t(std::max(ra, rb))] = std::min(ra, rb);
+    const std::int32_t ia = id(a), ib = id(b);
+    detail::unite(parent.data(), ia, ib);
   }
   int components = 0;
-  for (std::size_t i = 0; i < node.size(); ++i) components += parent[i] == std::int32_t(i);
+  for (std::size_t i = 0; i < node.size(); ++i)
+    components += detail::find_root(parent.data(), std::int32_t(i)) == std::int32_t(i);
   return components;
 }
 
