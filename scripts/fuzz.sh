@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets of tests/fuzz (clang, -fsanitize=fuzzer,address,undefined) and runs
-# each for a bounded time on its checked-in corpus and regression inputs.
+# each for a bounded time (or number of inputs) on its checked-in corpus and regression inputs.
 # Usage: scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]   (default 20 s; all targets)
 #   CONFORM_FUZZ_RUNS       instead of a time: this many inputs per target ("ci": each
 #                           target's CI budget below), from seed CONFORM_FUZZ_SEED (default 1),

@@ -199,7 +199,7 @@ TEST(Drill, PropertyRandomDrillsOnTheArm) {
 }
 
 TEST(Drill, PropertyDrillsAlongCoarseArmsLeaveNoPinchedVertex) {
-  // Axes close to the arm's own (tilted by up to 22 degrees) through coarse arms: the rim then
+  // Axes close to the arm's own (tilted by up to 30 degrees) through coarse arms: the rim then
   // runs nearly along the surface and, on a coarse mesh, can pass through a snapped rim vertex
   // twice. The surface stays manifold (no two fans of faces meeting at a vertex, no edge used
   // thrice), with and without the tube. Found by the mesh_ops fuzz target
