@@ -190,6 +190,48 @@ TEST(Cut, CapsFollowEachLoopsDirectionWhenPiecesOverlap) {
   }
 }
 
+// `m` with every face reversed (an inside-out surface) and moved by `shift`.
+SkinnedMesh inside_out(SkinnedMesh m, const Eigen::Vector3d& shift = Eigen::Vector3d::Zero()) {
+  for (Face& f : m.faces) std::swap(f[1], f[2]);
+  m.rest.colwise() += shift, m.current.colwise() += shift;
+  return m;
+}
+
+TEST(Cut, CapsOfAnInsideOutSurfaceAreOrientedLikeItsFaces) {
+  // A surface can be inside out (a piece turned through itself in a running simulation, a
+  // model wound the other way): its loop runs clockwise with no loop around it. Its caps are
+  // oriented like its own faces, alone, beside an outward sphere in the same plane, and
+  // inside one (then the outward sphere's loop runs against the inside-out one's nesting).
+  const SkinnedMesh ball = make_icosphere(3, 1.0), small = make_icosphere(3, 0.5);
+  struct Case {
+    std::string name;
+    SkinnedMesh mesh;
+    int inside_out_pieces;
+  };
+  const std::vector<Case> cases = {
+      {"alone", inside_out(ball), 2},
+      {"beside an outward sphere", together(inside_out(ball, {3, 0, 0}), ball), 2},
+      {"around an outward sphere", together(inside_out(ball), small), 2}};
+  for (const Case& c : cases) {
+    SkinnedMesh m = c.mesh;
+    Adjacency adj(m);
+    const auto out = cut(m, adj, Plane::from_normal_distance({0.1, 0.2, 1}, 0.1), {.cap = true});
+    ASSERT_EQ(out.result.status, CutStatus::Cut) << c.name;
+    EXPECT_EQ(out.result.capped_loops, out.result.loops) << c.name << ": " << out.result.message;
+    int negative = 0;
+    for (std::int32_t p = 0; p < out.pieces.count; ++p) {
+      SkinnedMesh piece = m;
+      piece.faces.clear();
+      for (auto f : out.pieces.faces_of(p)) piece.faces.push_back(m.faces[std::size_t(f)]);
+      const MeshReport r = check_mesh(piece);
+      EXPECT_TRUE(r.closed() && r.oriented() && r.manifold())
+          << c.name << ", piece " << p << ": " << r.summary();
+      negative += signed_volume(piece) < 0;
+    }
+    EXPECT_EQ(negative, c.inside_out_pieces) << c.name;
+  }
+}
+
 TEST(Cut, OnePlaneManyPieces) {
   // A U-shaped tube (the cylinder bent by hand) cut across both legs gives three pieces.
   SkinnedMesh m = make_cylinder(24, 40, 0.1, 2.0);

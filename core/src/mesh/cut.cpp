@@ -103,6 +103,7 @@ class CutComputation {
     check_input();
     measure_distances();
     result_.change.base_vertex_count = nv0_;
+    result_.change.edit = EditKind::cut;
     result_.change.base_face_count = nf0_;
     if (nf0_ == 0) return std::move(result_);
     eps_ = options_.plane_tolerance * diagonal_;
@@ -831,8 +832,8 @@ class CutComputation {
 
   // The triangulation of the section (in groups whose loops run as their nesting says,
   // oriented_sections.hpp); each triangle caps both sides. Section triangles turn
-  // counter-clockwise about n: the negative piece's cap faces +n as they are, the positive
-  // piece's is reversed.
+  // counter-clockwise about n (clockwise where the surface is inside out): the negative piece's
+  // cap faces +n as they are, the positive piece's is reversed.
   void add_cap_faces(const std::vector<std::vector<Eigen::Vector2d>>& loops2,
                      const ForbiddenDiagonals& forbidden, std::vector<std::string>& problems) {
     const detail::OrientedSections section =
@@ -841,12 +842,9 @@ class CutComputation {
       problems.push_back(section.problem);
       return;
     }
-    if (section.against_nesting > 0)
-      problems.push_back(
-          "a cut loop runs against its nesting (an inside-out surface, or pieces overlapping "
-          "in the plane)");
     result_.capped_loops = section.capped_loops;
     result_.nested_loops = section.nested_loops;
+    result_.inside_out_loops = section.inside_out_loops;
     TopologyChange& ch = result_.change;
     ch.added_faces.reserve(ch.added_faces.size() + 2 * section.triangles.size());
     const auto first = static_cast<std::int32_t>(ch.added_faces.size());

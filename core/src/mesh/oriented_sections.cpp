@@ -57,36 +57,42 @@ OrientedSections oriented_sections(const std::vector<std::vector<Eigen::Vector2d
   std::vector<std::size_t> pending(loops.size());
   std::iota(pending.begin(), pending.end(), std::size_t(0));
   std::vector<std::int32_t> global;
-  // Each round caps a group (its outermost loops always stay in it), so this ends.
+  // Each round caps a group: of the loops left, those that run as their nesting in the group
+  // says (outer counter-clockwise, holes clockwise), or, when none does, those that all run
+  // the other way (an inside-out surface: the group's triangles are reversed). The rest wait
+  // for a later round. The group never empties and the rest shrinks, so this ends.
   while (!pending.empty()) {
     std::vector<std::size_t> group = pending, deferred;
     SectionTriangulation section;
-    while (!group.empty()) {
+    bool inside_out = false;
+    while (true) {
       section = sections.triangulate(group, global);
       if (!section.ok()) {
         OrientedSections failed;
         failed.problem = section.problem;
         return failed;
       }
-      std::vector<std::size_t> agree;
-      for (std::size_t k = 0; k < group.size(); ++k) {
-        const bool even = section.depth[k] % 2 == 0;
-        // An outermost loop is kept either way (an inside-out surface is capped as before).
-        if (counter_clockwise[group[k]] == even || section.depth[k] == 0)
-          agree.push_back(group[k]);
-        else
-          deferred.push_back(group[k]);
+      std::vector<std::size_t> as_nested, reversed;
+      for (std::size_t k = 0; k < group.size(); ++k)
+        (counter_clockwise[group[k]] == (section.depth[k] % 2 == 0) ? as_nested : reversed)
+            .push_back(group[k]);
+      if (as_nested.size() == group.size() || reversed.size() == group.size()) {
+        inside_out = reversed.size() == group.size();
+        break;
       }
-      if (agree.size() == group.size()) break;
-      group = std::move(agree);
+      // Both kinds (pieces overlapping in the plane): the reversed ones wait, and nest anew
+      // among themselves in a later round.
+      deferred.insert(deferred.end(), reversed.begin(), reversed.end());
+      group = std::move(as_nested);
     }
-    if (!group.empty()) {
-      for (const auto& t : section.triangles)
-        out.triangles.push_back(
-            {global[std::size_t(t[0])], global[std::size_t(t[1])], global[std::size_t(t[2])]});
-      out.capped_loops += std::int32_t(group.size());
-      for (const auto d : section.depth) out.nested_loops += d > 0;
+    for (const auto& t : section.triangles) {
+      const std::int32_t a = global[std::size_t(t[0])], b = global[std::size_t(t[1])],
+                         c = global[std::size_t(t[2])];
+      out.triangles.push_back(inside_out ? std::array{a, c, b} : std::array{a, b, c});
     }
+    out.capped_loops += std::int32_t(group.size());
+    out.inside_out_loops += inside_out ? std::int32_t(group.size()) : 0;
+    for (const auto d : section.depth) out.nested_loops += d > 0;
     pending = std::move(deferred);
   }
   return out;

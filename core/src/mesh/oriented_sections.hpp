@@ -5,12 +5,13 @@
 // loop runs as the positive side's boundary of a closed, outward-oriented surface does: at an
 // even nesting depth counter-clockwise, at an odd depth (a hole) clockwise. In a running
 // simulation pieces overlap, so one piece's loop can lie inside another's and be taken for its
-// hole, and a surface can be inside out there: capped as one section, such a loop would get cap
-// faces oriented like their neighbours (edges used twice in one direction). So the loops are
-// triangulated in groups: the loops against their nesting are set aside and the others
-// triangulated again until every loop of the group agrees, and the loops set aside make the
-// next group (where the overlapping piece's loop is an outer loop of its own). An outermost
-// loop is capped as it is (an inside-out surface keeps the old caps: a known limit).
+// hole: capped as one section, such a loop would get cap faces oriented like their neighbours
+// (edges used twice in one direction). So the loops are triangulated in groups: the loops
+// against their nesting are set aside and the others triangulated again until every loop of
+// the group agrees, and the loops set aside make the next group (where the overlapping piece's
+// loop is an outer loop of its own). A group all of whose loops run against their nesting (an
+// inside-out surface: outer loops clockwise, holes counter-clockwise) is triangulated as it
+// nests and its triangles reversed, so that its caps are oriented like its own faces.
 #pragma once
 
 #include <array>
@@ -23,12 +24,13 @@
 namespace conform::mesh::detail {
 
 struct OrientedSections {
-  /// Counter-clockwise triangles; indices into the loops' vertices concatenated in order.
+  /// Triangles counter-clockwise, clockwise in an inside-out group (the caps' orientation on the
+  /// negative side); indices into the loops' vertices concatenated in order.
   std::vector<std::array<std::int32_t, 3>> triangles;
   std::int32_t capped_loops = 0;
-  std::int32_t nested_loops = 0;     // capped loops inside another loop of their group
-  std::int32_t against_nesting = 0;  // always 0: outermost loops are capped as they are
-  std::string problem;               // a triangulation's problem; then no triangles at all
+  std::int32_t nested_loops = 0;      // capped loops inside another loop of their group
+  std::int32_t inside_out_loops = 0;  // capped loops of groups running against their nesting
+  std::string problem;                // a triangulation's problem; then no triangles at all
 };
 
 OrientedSections oriented_sections(const std::vector<std::vector<Eigen::Vector2d>>& loops,

@@ -77,11 +77,12 @@ struct CutResult {
   std::int32_t snapped_vertices = 0;  // vertices taken as on the plane by step 2 (snaps)
   std::int32_t loops = 0;             // closed cut loops found (when capping)
   std::int32_t capped_loops = 0;
-  std::int32_t nested_loops = 0;   // capped loops inside another loop (holes, islands)
-  std::int32_t cap_faces = 0;      // per side
-  std::int32_t sections = 0;       // with a region: the sections the plane crosses
-  std::int32_t kept_sections = 0;  // with a region: those it kept (cut)
-  std::string message;             // why a loop was not capped, or why the cut missed
+  std::int32_t nested_loops = 0;      // capped loops inside another loop (holes, islands)
+  std::int32_t inside_out_loops = 0;  // capped loops of an inside-out surface (caps reversed)
+  std::int32_t cap_faces = 0;         // per side
+  std::int32_t sections = 0;          // with a region: the sections the plane crosses
+  std::int32_t kept_sections = 0;     // with a region: those it kept (cut)
+  std::string message;                // why a loop was not capped, or why the cut missed
 };
 
 /// Computes the change without touching the mesh. O(V + F) for the classification, then
