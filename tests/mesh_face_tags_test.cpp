@@ -17,6 +17,7 @@
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/face_index.hpp"
 #include "conform/mesh/primitives.hpp"
+#include "conform/mesh/tear.hpp"
 
 using namespace conform;
 using namespace conform::mesh;
@@ -154,6 +155,9 @@ TEST(FaceTags, RefusedWhenInconsistentOrOutOfRange) {
   c.new_surface = {{0, 1, FaceKind(7)}};
   EXPECT_EQ(c.validate(), "new surface of unknown kind");
   c.new_surface = {{0, 1, FaceKind::cap}};
+  c.edit = EditKind(9);
+  EXPECT_EQ(c.validate(), "a change of unknown edit kind");
+  c.edit = EditKind::other;
   EXPECT_EQ(c.validate(), "");
   m.face_tags.resize(1);
   try {
@@ -164,11 +168,48 @@ TEST(FaceTags, RefusedWhenInconsistentOrOutOfRange) {
   }
   m.face_tags.clear();
   apply(m, c);
-  EXPECT_EQ(m.face_tag(0), (FaceTag{FaceKind::cap, 1}));
-  EXPECT_EQ(m.face_tag(1), (FaceTag{FaceKind::skin, 0}));
+  EXPECT_EQ(m.face_tag(0), (FaceTag{FaceKind::cap, 1, EditKind::other}));  // made by hand
+  EXPECT_EQ(m.face_tag(1), (FaceTag{FaceKind::skin, 0, EditKind::model}));
 }
 
-TEST(FaceTags, PlyCarriesSurfaceAndOp) {
+TEST(FaceTags, EachFaceNamesTheKindOfEditThatMadeIt) {
+  // A cut (op 1), a drill (op 2), then a tear (ops 3 on, one per change it applies) on one
+  // sphere: every face's edit is the kind of the operation whose op it carries, the model's
+  // faces alone have op 0 and edit model, and every operation left faces of its kind.
+  SkinnedMesh m = make_icosphere(4);
+  Adjacency adj(m);
+  ASSERT_EQ(
+      cut(m, adj, Plane::from_normal_distance({0, 0, 1}, 0.6), {.cap = true}).result.capped_loops,
+      1);
+  const std::uint32_t after_cut = m.edits;
+  FaceIndex index(m);
+  const DrillResult d = drill(m, adj, index, {{0.5, 0.1, 2}, {0.5, 0.1, -2}, 0.15}, {});
+  ASSERT_GT(d.holes, 0) << d.message;
+  const std::uint32_t after_drill = m.edits;
+  Tear tear(m, adj);
+  for (int i = 0; i < 20; ++i) {
+    const double a = -0.6 + 0.04 * i;  // a stroke over the sphere's side, away from the hole
+    tear.advance({double(i),
+                  {-2 * std::cos(a), 2 * std::sin(a), -0.1},
+                  {-0.5 * std::cos(a), 0.5 * std::sin(a), 0.1}});
+  }
+  ASSERT_GT(m.edits, after_drill + 2);
+  std::map<EditKind, std::int32_t> faces;
+  for (std::int32_t f = 0; f < m.face_count(); ++f) {
+    const FaceTag tag = m.face_tag(f);
+    const EditKind expected = tag.op == 0             ? EditKind::model
+                              : tag.op <= after_cut   ? EditKind::cut
+                              : tag.op <= after_drill ? EditKind::drill
+                                                      : EditKind::tear;
+    EXPECT_EQ(tag.edit, expected) << "face " << f << ", op " << tag.op;
+    ++faces[tag.edit];
+  }
+  for (const EditKind k : {EditKind::model, EditKind::cut, EditKind::drill, EditKind::tear})
+    EXPECT_GT(faces[k], 0) << int(k);
+  EXPECT_EQ(faces[EditKind::other], 0);
+}
+
+TEST(FaceTags, PlyCarriesSurfaceOpAndEdit) {
   SkinnedMesh m = make_icosphere(2);
   Adjacency adj(m);
   const Plane plane = Plane::from_normal_distance({0, 0, 1}, 0.3);
@@ -185,17 +226,18 @@ TEST(FaceTags, PlyCarriesSurfaceAndOp) {
     std::sscanf(line.c_str(), "element face %d", &nf);
   }
   EXPECT_NE(header.find("property list uchar int vertex_indices\nproperty uchar surface\n"
-                        "property uint op\n"),
+                        "property uint op\nproperty uchar edit\n"),
             std::string::npos)
       << header;
   ASSERT_EQ(nf, m.face_count());
   for (int i = 0; i < nv; ++i) std::getline(is, line);
   for (int f = 0; f < nf; ++f) {
-    int n = 0, a = 0, b = 0, c = 0, surface = -1;
+    int n = 0, a = 0, b = 0, c = 0, surface = -1, edit = -1;
     unsigned op = 99;
-    is >> n >> a >> b >> c >> surface >> op;
+    is >> n >> a >> b >> c >> surface >> op >> edit;
     EXPECT_EQ(surface, int(m.face_tag(f).kind)) << f;
     EXPECT_EQ(op, m.face_tag(f).op) << f;
+    EXPECT_EQ(edit, int(m.face_tag(f).edit)) << f;
   }
   std::filesystem::remove(path);
 }

@@ -192,7 +192,7 @@ std::string encode_ply(const Eigen::Ref<const Eigen::Matrix3Xd>& pos, const Attr
   if (a.normals) out += "property double nx\nproperty double ny\nproperty double nz\n";
   out += "element face " + std::to_string(s.faces.size()) + "\n";
   out += "property list uchar int vertex_indices\n";
-  if (a.tags) out += "property uchar surface\nproperty uint op\n";
+  if (a.tags) out += "property uchar surface\nproperty uint op\nproperty uchar edit\n";
   out += "end_header\n";
   for (std::size_t i = 0; i < s.vertices.size(); ++i) {
     std::array<double, 8> values{};
@@ -210,7 +210,9 @@ std::string encode_ply(const Eigen::Ref<const Eigen::Matrix3Xd>& pos, const Attr
     if (binary) {
       put(out, static_cast<std::uint8_t>(3));
       for (auto v : f) put(out, static_cast<std::int32_t>(v));
-      if (a.tags) put(out, static_cast<std::uint8_t>(tag.kind)), put(out, tag.op);
+      if (a.tags)
+        put(out, static_cast<std::uint8_t>(tag.kind)), put(out, tag.op),
+            put(out, static_cast<std::uint8_t>(tag.edit));
     } else {
       // Appended piecewise: GCC 12 reports a false -Wrestrict on "3 " + std::string.
       out += "3";
@@ -219,7 +221,9 @@ std::string encode_ply(const Eigen::Ref<const Eigen::Matrix3Xd>& pos, const Attr
         out.append(" ")
             .append(std::to_string(static_cast<int>(tag.kind)))
             .append(" ")
-            .append(std::to_string(tag.op));
+            .append(std::to_string(tag.op))
+            .append(" ")
+            .append(std::to_string(static_cast<int>(tag.edit)));
       out += "\n";
     }
   }

@@ -263,6 +263,7 @@ TopologyChange start_change(Region& region, const SkinnedMesh& mesh, bool tube,
                             DrillResult& result) {
   TopologyChange ch;
   ch.base_vertex_count = mesh.vertex_count();
+  ch.edit = EditKind::drill;
   ch.base_face_count = mesh.face_count();
   for (const Face& t : region.added)
     for (auto v : t)

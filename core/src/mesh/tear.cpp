@@ -873,6 +873,7 @@ Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, FaceIndex& index, const Tear
 }
 
 void Tear::commit(TopologyChange&& change, TearStep& step) {
+  change.edit = EditKind::tear;
   apply(mesh_, change, &adjacency_);
   if (index_) index_->update(mesh_, change);
   step.changes.push_back(std::move(change));

@@ -55,6 +55,7 @@ std::string TopologyChange::validate() const {
       return "new surface of unknown kind";
     covered = std::int64_t(run.first) + run.count;
   }
+  if (edit > EditKind::other) return "a change of unknown edit kind";
   return {};
 }
 
@@ -176,7 +177,8 @@ void apply_vertices(SkinnedMesh& mesh, const TopologyChange& change) {
 // (otherwise every origin is skin); `origins` is the corner attributes' when they ran.
 static std::vector<FaceTag> added_face_tags(const SkinnedMesh& mesh, const TopologyChange& change,
                                             const std::vector<std::int32_t>& origins) {
-  const FaceTag made{FaceKind::skin, mesh.edits + 1};
+  const FaceTag made{FaceKind::skin, mesh.edits + 1,
+                     change.edit == EditKind::model ? EditKind::other : change.edit};
   std::vector<FaceTag> tags(change.added_faces.size(), made);
   const bool inherit = std::any_of(
       change.removed_faces.begin(), change.removed_faces.end(),

@@ -6,9 +6,10 @@
 // the corner normals are written too. A mesh without corner attributes is written as before:
 // one vertex per vertex, its UVs, no normals.
 //
-// Face tags (skinned_mesh.hpp). A PLY of a mesh with face tags gives each face two more
-// properties after its vertex_indices: `uchar surface` (0 skin, 1 cap, 2 tube wall) and
-// `uint op` (the change that made the face, 0: the model). OBJ has no face properties: none.
+// Face tags (skinned_mesh.hpp). A PLY of a mesh with face tags gives each face three more
+// properties after its vertex_indices: `uchar surface` (0 skin, 1 cap, 2 tube wall), `uint op`
+// (the change that made the face, 0: the model) and `uchar edit` (that change's kind: 0 model,
+// 1 cut, 2 tear, 3 drill, 4 other). OBJ has no face properties: none.
 //
 // Files are written atomically: the data go to a temporary file in the same directory, which
 // is renamed over the target only once it is complete, so a reader never sees half a mesh.
@@ -33,7 +34,7 @@ struct MeshExportOptions {
   bool uvs = true;
   /// Write normals when the mesh has corner normals (PLY: nx, ny, nz; OBJ: vn lines).
   bool normals = true;
-  /// Write the face tags when the mesh has them (PLY only: surface, op).
+  /// Write the face tags when the mesh has them (PLY only: surface, op, edit).
   bool face_tags = true;
 };
 

@@ -24,11 +24,12 @@
 //
 // Face tags. Every face is skin (from the model), cap (the section a capped cut closes) or tube
 // wall (a drill's tube), and records the change that made it: `edits` counts the
-// TopologyChanges applied to the mesh, and a face added by change n (1, 2, …) has op n; faces
-// from the model have op 0. An added face listed in the change's `new_surface` gets that kind;
-// every other added face lies in a removed face (a split or relabelled face) and keeps that
-// face's kind (cap pieces of a later tear stay cap). Tags follow their face through every slot
-// operation (topology_change.hpp), as the corner attributes do.
+// TopologyChanges applied to the mesh, and a face added by change n (1, 2, …) has op n and that
+// change's kind of edit (cut, tear, drill, other); faces from the model have op 0, edit model. An
+// added face listed in the change's `new_surface` gets that kind; every other added face lies in a
+// removed face (a split or relabelled face) and keeps that face's kind (cap pieces of a later tear
+// stay cap). Tags follow their face through every slot operation (topology_change.hpp), as the
+// corner attributes do.
 #pragma once
 
 #include <Eigen/Core>
@@ -47,9 +48,14 @@ using Face = std::array<std::int32_t, 3>;
 /// What surface a face is (see "Face tags" above). Values are stable (written to PLY).
 enum class FaceKind : std::uint8_t { skin = 0, cap = 1, tube = 2 };
 
+/// What kind of edit a change is (TopologyChange::edit), so what made a face. Values are
+/// stable (written to PLY). `other`: a change made by hand or by another operation (refine).
+enum class EditKind : std::uint8_t { model = 0, cut = 1, tear = 2, drill = 3, other = 4 };
+
 struct FaceTag {
   FaceKind kind = FaceKind::skin;
-  std::uint32_t op = 0;  // the change that made the face (0: the model)
+  std::uint32_t op = 0;             // the change that made the face (0: the model)
+  EditKind edit = EditKind::model;  // that change's kind (model: the face is the model's)
   bool operator==(const FaceTag&) const = default;
 };
 

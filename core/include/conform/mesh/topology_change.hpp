@@ -68,6 +68,7 @@ struct TopologyChange {
   std::vector<std::int32_t> removed_faces;  // strictly increasing
   std::vector<Face> added_faces;
   std::vector<NewSurface> new_surface;  // increasing, disjoint runs of added faces
+  EditKind edit = EditKind::other;      // what made the change: its added faces' tags say so
 
   bool empty() const {
     return new_vertices.empty() && removed_faces.empty() && added_faces.empty();
