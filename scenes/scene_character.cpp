@@ -120,7 +120,9 @@ class Character final : public Scene {
     bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(model, material);
     // No loop: this animation's last key is not its first, and the wrap would be a jump.
     body.play(animation, skin::Blend::log, false);
-    body.snap_to_pose();  // start at the animation's first pose, not the bind pose (no spike)
+    // The first substep would start the body on the animation's first pose by itself; the
+    // snap does it now, so that frame 0 and the start targets below are of that pose.
+    body.snap_to_pose();
     const BindPose bind(model.mesh);
     const SeamGap seams(file_rest, weld.vertex_map);
     TearRun tear(tear_, bind);

@@ -116,6 +116,15 @@ void SkinnedSoftBody::Impl::update(double dt, double time) {
   if (!lost_.empty()) throw std::logic_error("SkinnedSoftBody: cannot step: " + lost_);
   if (!(dt > 0)) return;
   time_ = time;
+  if (!started_) {
+    // The first substep starts on the pose source's pose at its start time, not on the bind
+    // pose the body was built in: no jump (a speed spike) towards the first pose.
+    started_ = true;
+    if (source_chosen_) {
+      if (!clock_) clock_now_ = time - dt;
+      place_on_pose();
+    }
+  }
   if (clock_) {
     if (!clock_->paused) clock_now_ += clock_->speed * dt;
   } else {
@@ -221,6 +230,11 @@ void SkinnedSoftBody::Impl::set_clock(const Clock& clock) {
 
 void SkinnedSoftBody::Impl::snap_to_pose() {
   check_editable("snap_to_pose");
+  started_ = true;
+  place_on_pose();
+}
+
+void SkinnedSoftBody::Impl::place_on_pose() {
   drive_.settle(mesh_, clock_now_);
   for (auto& piece : pieces_) {
     if (!piece || !piece->body || piece->released) continue;

@@ -165,6 +165,7 @@ void SkinnedSoftBody::Impl::play(const skin::Animation& animation, skin::Blend b
     throw std::invalid_argument("SkinnedSoftBody::play: animation '" + animation.name +
                                 "' does not fit the skeleton: " + problem);
   drive_.play(animation, blend, loop);
+  source_chosen_ = true;
 }
 
 bool SkinnedSoftBody::Impl::is_kinematic_by_weight(std::int32_t v) const {

@@ -44,18 +44,24 @@ struct SkinnedSoftBody::Impl {
   Impl& operator=(const Impl&) = delete;
 
   // --- Pose sources (the last one set wins). Time is the plugin's simulated time, s. ---
-  void set_pose(const skin::Pose& pose) { drive_.set_pose(pose); }
+  void set_pose(const skin::Pose& pose) {
+    drive_.set_pose(pose);
+    source_chosen_ = true;
+  }
   void play(const skin::Animation& animation, skin::Blend blend = skin::Blend::linear,
             bool loop = true);
   void set_keyframes(skin::PoseTrack track, skin::Blend blend = skin::Blend::linear) {
     drive_.set_keyframes(std::move(track), blend);
+    source_chosen_ = true;
   }
   void set_pose_source(std::function<void(double time, skin::Pose& pose)> source) {
     drive_.set_pose_source(std::move(source));
+    source_chosen_ = true;
   }
   void set_skin_threads(int threads) { drive_.set_threads(threads); }
   void set_clock(const Clock& clock);
   void snap_to_pose();
+  void place_on_pose();  // snap_to_pose() without the edit check (also from the first substep)
   void set_pinned(std::span<const std::int32_t> vertices);
 
   // --- Topology changes: on the simulated positions, only between stepSimulation calls. ---
@@ -271,6 +277,8 @@ struct SkinnedSoftBody::Impl {
   std::optional<mesh::ScalpelSample> blade_;  // the last tear sample (debug drawing)
   std::optional<Clock> clock_;                // the body's own animation clock, when set
   double clock_now_ = 0;                      // the time the pose source was last sampled at
+  bool started_ = false;        // stepped or snapped once: the first substep's start is done
+  bool source_chosen_ = false;  // a pose source was set: the first substep starts on its pose
   ApplyStats stats_;
 };
 

@@ -195,8 +195,11 @@ class SkinnedSoftBody {
   /// The time the pose source was last sampled at, s.
   double clock_time() const;
   /// Places every node in Bullet on its skinned target at the current time, at rest (position
-  /// = target, velocity 0). Call after choosing the pose source and before stepping, so that
-  /// the first substep does not jump from the bind pose to the source's first pose.
+  /// = target, velocity 0). The body's first substep does this by itself when a pose source
+  /// was set (set_pose, play, set_keyframes or set_pose_source), at the substep's start time,
+  /// so that it does not jump from the bind pose it was built in to the source's first pose;
+  /// without a pose source the nodes start where the mesh's `current` put them. Call it to
+  /// place the body again later (after a jump of the pose source or of the world transform).
   void snap_to_pose();
   /// OpenMP threads of the skinning loop; 0 = the library's choice. Default 1: a fork/join
   /// every substep costs more than it saves on a few thousand vertices, and idle OpenMP
