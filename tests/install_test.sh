@@ -67,6 +67,30 @@ cmake -S "$work/right" -B "$work/right/build" -DCMAKE_PREFIX_PATH="$work/prefix"
   { cat "$work/right.log"; fail "a project of the package's Bullet precision was refused"; }
 echo "install_test: a project of $wrong-precision Bullet is refused at configure time, one of $mine configures"
 
+# What configure time cannot see, a single target of the other precision, the package's headers
+# refuse at compile time (precision.hpp), naming both precisions.
+mkdir -p "$work/wrong-target"
+cp "$work/right/CMakeLists.txt" "$work/wrong-target/CMakeLists.txt"
+printf '#include "conform/bullet/plugin.hpp"\nint main() { return 0; }\n' >"$work/wrong-target/main.cpp"
+if [[ "$mine" == float ]]; then
+  target_line='target_compile_definitions(app PRIVATE BT_USE_DOUBLE_PRECISION)'
+  expected="built against float-precision Bullet, but this translation unit defines BT_USE_DOUBLE_PRECISION"
+else
+  target_line='target_compile_options(app PRIVATE -UBT_USE_DOUBLE_PRECISION)'
+  expected="built against double-precision Bullet, but this translation unit does not define"
+fi
+printf 'add_executable(app main.cpp)\ntarget_link_libraries(app PRIVATE conform::bullet)\n%s\n' \
+  "$target_line" >>"$work/wrong-target/CMakeLists.txt"
+cmake -S "$work/wrong-target" -B "$work/wrong-target/build" -DCMAKE_PREFIX_PATH="$work/prefix" \
+  >"$work/wrong-target.log" 2>&1 ||
+  { cat "$work/wrong-target.log"; fail "the single-target project did not configure"; }
+if cmake --build "$work/wrong-target/build" >>"$work/wrong-target.log" 2>&1; then
+  fail "a target of $wrong-precision Bullet ($target_line) compiled against the $mine package"
+fi
+grep -qF "$expected" "$work/wrong-target.log" ||
+  { cat "$work/wrong-target.log"; fail "the single target's precision was refused without its message"; }
+echo "install_test: a single target of $wrong-precision Bullet is refused at compile time"
+
 # A package built with CONFORM_SANITIZE holds instrumented code: its consumers must be built
 # with the same sanitizers (their runtime), as the sanitized CI stage does.
 sanitize_flags="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"

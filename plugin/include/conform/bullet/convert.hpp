@@ -1,6 +1,8 @@
 // Conversions between Conform's algebra and Bullet's types (btScalar follows Bullet's build).
 #pragma once
 
+#include "conform/bullet/precision.hpp"  // the package's Bullet precision, checked
+
 #include <LinearMath/btTransform.h>
 
 #include "conform/cga/motor.hpp"

@@ -10,6 +10,8 @@
 // inspection and teardown.
 #pragma once
 
+#include "conform/bullet/precision.hpp"  // the package's Bullet precision, checked
+
 #include <Eigen/Core>
 #include <cstdint>
 #include <stdexcept>

@@ -10,6 +10,8 @@
 // SkinnedSoftBody::piece_valid says so, instead of a use-after-free).
 #pragma once
 
+#include "conform/bullet/precision.hpp"  // the package's Bullet precision, checked
+
 #include <BulletCollision/BroadphaseCollision/btBroadphaseProxy.h>
 #include <BulletSoftBody/btSoftBody.h>
 

@@ -36,6 +36,8 @@
 //     lengths to the current lengths after any edit, which would wipe pretension).
 #pragma once
 
+#include "conform/bullet/precision.hpp"  // the package's Bullet precision, checked
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>

@@ -2,6 +2,8 @@
 // broadphase and solvers: the world the plugin's tests, benchmarks and scenes run in.
 #pragma once
 
+#include "conform/bullet/precision.hpp"  // the package's Bullet precision, checked
+
 #include <BulletSoftBody/btDefaultSoftBodySolver.h>
 #include <BulletSoftBody/btSoftBodyRigidBodyCollisionConfiguration.h>
 #include <BulletSoftBody/btSoftRigidDynamicsWorld.h>
