@@ -519,7 +519,7 @@ TEST(Cut, ReDeformation) {
 TEST(Cut, PropertyRealModels) {
   // Real rigged models from assimp-testmodels (they need not be closed or manifold: the
   // invariants that hold for the input are checked).
-  int cuts = 0, pinched = 0;
+  int cuts = 0, capped = 0, unsnapped = 0;
   for (const char* file :
        {"FBX/huesitos.fbx", "X/anim_test.x", "glTF2/simple_skin/simple_skin.gltf"}) {
     const std::filesystem::path path = std::filesystem::path(CONFORM_ASSIMP_MODELS) / file;
@@ -541,18 +541,21 @@ TEST(Cut, PropertyRealModels) {
       expect_area_kept(in, m, out.result, what);
       EXPECT_GE(added_face_angles(in, m, kCutMinAngle, cap_faces(out.result)).worst_ratio, 1 - 1e-9)
           << what << ": a sliver";
-      // Every loop is capped but those through a vertex where the surface touches the plane
-      // in several fans (a documented limit: 4 of huesitos' 92 capped trials).
-      if (trial % 2 == 0 && out.result.capped_loops < out.result.loops) {
-        ++pinched;
-        EXPECT_NE(out.result.message.find("several fans"), std::string::npos)
-            << what << ": " << out.result.message;
+      // Every loop is capped, also where a vertex snapped onto the plane near a saddle would
+      // make the section meet itself (4 of huesitos' 92 capped trials did, uncapped, before
+      // the cut kept such vertices off the plane: `unsnapped_vertices`).
+      if (trial % 2 == 0) {
+        EXPECT_EQ(out.result.capped_loops, out.result.loops) << what << ": " << out.result.message;
+        capped += out.result.loops > 0;
+        unsnapped += out.result.unsnapped_vertices > 0;
       }
       if (testing::Test::HasFailure()) return;
     }
   }
   if (cuts == 0) GTEST_SKIP() << "assimp-testmodels not installed";
   EXPECT_GT(cuts, 100);
-  EXPECT_LE(pinched, 10);
-  RecordProperty("uncapped_pinched_trials", pinched);
+  EXPECT_GT(unsnapped, 0);  // the case occurs
+  std::printf("capped trials %d, of which %d kept a pinching vertex off the plane\n", capped,
+              unsnapped);
+  RecordProperty("unsnapped_trials", unsnapped);
 }

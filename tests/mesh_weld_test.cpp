@@ -356,8 +356,11 @@ TEST(Weld, CappedCutsCloseEveryLoopAndKeepTheCorners) {
   // face the cut does not touch keeps its corners exactly, and new corners have unit normals.
   // On the models that welding makes one closed manifold surface (the split files were 3 to
   // 176 pieces) every loop is capped; the split files' cuts were open curves at the seams.
-  // (X/Testwuson.X, X/BCN_Epileptic.X and SMD/WusonSMD.smd stay open, with non-manifold
-  // vertices or crossing shells after welding: their loop counts are printed, not checked.)
+  // X/Testwuson.X and SMD/WusonSMD.smd stay open after welding (non-manifold vertices), yet
+  // every closed loop of theirs is capped too (2 of 15 each were not, before the cut kept
+  // vertices that would pinch a loop off the plane). X/BCN_Epileptic.X has crossing shells:
+  // loops that cross in the section, and a loop through a vertex where its surface meets the
+  // plane in several fans by itself; its counts and reasons are printed, not checked.
   int cuts = 0, loops = 0, capped = 0, split_loops = 0, split_capped = 0;
   for (const auto& [file, split, welded] : models()) {
     const SkinnedMesh& in = welded.mesh;
@@ -379,6 +382,8 @@ TEST(Weld, CappedCutsCloseEveryLoopAndKeepTheCorners) {
             file + " axis " + std::to_string(axis) + " at " + std::to_string(at);
         ++cuts;
         model_loops += out.result.loops, model_capped += out.result.capped_loops;
+        if (out.result.capped_loops < out.result.loops)
+          std::printf("%s: %s\n", what.c_str(), out.result.message.c_str());
         if (closed) {
           EXPECT_EQ(out.result.capped_loops, out.result.loops)
               << what << ": " << out.result.message;
@@ -397,6 +402,9 @@ TEST(Weld, CappedCutsCloseEveryLoopAndKeepTheCorners) {
       }
     std::printf("%s%s: %d of %d loops capped\n", file.c_str(), closed ? " (closed)" : "",
                 model_capped, model_loops);
+    if (file != "X/BCN_Epileptic.X") {
+      EXPECT_EQ(model_capped, model_loops) << file;
+    }
   }
   if (cuts == 0) GTEST_SKIP() << "assimp-testmodels not installed";
   std::printf("closed models: %d of %d loops capped welded; split: %d of %d\n", capped, loops,

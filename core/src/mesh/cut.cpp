@@ -51,6 +51,7 @@ struct Scratch {
   std::vector<std::array<std::int32_t, 3>> pending_local;
   std::vector<std::uint8_t> ambiguous, visited, diagonal;
   std::vector<std::uint64_t> plus_edges;
+  std::vector<std::int32_t> unsnappable;  // sorted: vertices step 2 must not snap (pinches)
 };
 Scratch& scratch() {
   thread_local Scratch s;
@@ -349,13 +350,20 @@ class CutComputation {
     // Taking two of its vertices as on the plane always makes the face acceptable (it is no
     // longer crossed), so the nearest alone if that suffices, else the second nearest alone
     // if that does, else both.
+    // A vertex a snap would pinch (compute_cut's later rounds) is never taken: it sorts last,
+    // and the face keeps its sliver when only such vertices would do.
+    const std::vector<std::int32_t>& barred = sc_.unsnappable;
+    auto snappable = [&](int k) {
+      return barred.empty() || !std::binary_search(barred.begin(), barred.end(), f[k]);
+    };
     int order[3] = {0, 1, 2};
     std::sort(order, order + 3, [&](int i, int j) {
-      const double di = s[i] == 0 ? -1 : std::abs(dist(f[i]));
-      const double dj = s[j] == 0 ? -1 : std::abs(dist(f[j]));
+      const double di = s[i] == 0 ? -1 : snappable(i) ? std::abs(dist(f[i])) : INFINITY;
+      const double dj = s[j] == 0 ? -1 : snappable(j) ? std::abs(dist(f[j])) : INFINITY;
       return di < dj || (di == dj && i < j);
     });
     const int first = s[order[0]] == 0 ? 1 : 0;  // skip a vertex already on the plane
+    if (!snappable(order[first])) return;
     auto acceptable_without = [&](int k) {
       const std::int8_t keep = s[k];
       s[k] = 0;
@@ -369,13 +377,14 @@ class CutComputation {
       sc_.snapped_now.push_back(v);
       if (!(sc_.code[static_cast<std::size_t>(v)] & 16)) outside_work_ = true;
     };
+    const bool second = first == 0 && snappable(order[1]);
     if (acceptable_without(order[first])) {
       snap_vertex(f[order[first]]);
-    } else if (first == 0 && acceptable_without(order[1])) {
+    } else if (second && acceptable_without(order[1])) {
       snap_vertex(f[order[1]]);
     } else {
       snap_vertex(f[order[first]]);
-      if (first == 0) snap_vertex(f[order[1]]);
+      if (second) snap_vertex(f[order[1]]);
     }
   }
 
@@ -681,6 +690,19 @@ class CutComputation {
     if (!problems.empty()) result_.message = "not capped: " + problems.front();
   }
 
+  // A loop vertex where the surface meets the plane in several fans: when it is an original
+  // vertex that step 2 snapped (not on the plane by itself), compute_cut tries again without
+  // snapping it.
+  void note_pinch(std::int32_t l) {
+    if (l < nx_) return;
+    const std::int32_t v = global(l);
+    if (std::abs(sc_.dist[static_cast<std::size_t>(v)]) > eps_) pinched_snaps_.push_back(v);
+  }
+
+ public:
+  const std::vector<std::int32_t>& pinched_snaps() const { return pinched_snaps_; }
+
+ private:
   // Loop vertices (crossing vertices, and original vertices on the plane) get compact local
   // ids — crossing vertex nv0 + k is k, the i-th vertex of `plane_vertices` is nx + i — so
   // that the loop bookkeeping is flat arrays rather than hash maps.
@@ -746,10 +768,12 @@ class CutComputation {
                  w = static_cast<std::int32_t>(e & 0xffffffffu);
       if (std::binary_search(plus_edges.begin(), plus_edges.end(), edge_key(w, u))) continue;
       std::int32_t& to = sc_.next[static_cast<std::size_t>(u)];
-      if (to >= 0)
+      if (to >= 0) {
         branching_ = true;
-      else
+        note_pinch(u);
+      } else {
         to = w;
+      }
       sc_.starts.push_back(u);
     }
   }
@@ -813,7 +837,11 @@ class CutComputation {
       }
       ++result_.loops;
       bool amb = branching_;
-      for (auto v : loop) amb |= sc_.ambiguous[static_cast<std::size_t>(v)] != 0;
+      for (auto v : loop) {
+        if (!sc_.ambiguous[static_cast<std::size_t>(v)]) continue;
+        amb = true;
+        note_pinch(v);
+      }
       if (amb) {
         problems.push_back(
             "a cut loop through a vertex where the surface touches the plane in several fans");
@@ -881,10 +909,11 @@ class CutComputation {
   double diagonal_ = 0, reach_pos_ = 0, reach_neg_ = 0, eps_ = 0;
   bool face_pos_ = false, face_neg_ = false;  // a face lies on that side
   bool outside_work_ = false;  // a vertex not flagged near was snapped: its faces are not in work
-  std::vector<std::int32_t> split_;  // the crossed faces, then the re-indexed ones: removed
-  std::int32_t nx_ = 0;              // crossing vertices
-  std::size_t nloop_ = 0;            // loop vertices (local ids)
-  bool branching_ = false;           // a loop vertex with two boundary edges out
+  std::vector<std::int32_t> split_;          // the crossed faces, then the re-indexed ones: removed
+  std::int32_t nx_ = 0;                      // crossing vertices
+  std::size_t nloop_ = 0;                    // loop vertices (local ids)
+  bool branching_ = false;                   // a loop vertex with two boundary edges out
+  std::vector<std::int32_t> pinched_snaps_;  // snapped vertices where a loop meets itself
 };
 
 }  // namespace
@@ -893,7 +922,30 @@ namespace detail {
 
 CutResult compute_cut(const SkinnedMesh& mesh, const cga::Plane<double>& plane,
                       const CutOptions& options, Predicates predicates) {
-  return CutComputation(mesh, plane, options, predicates).run();
+  // A vertex near a saddle of the surface, snapped onto the plane, can make the section meet
+  // itself there (the surface touches the plane in two fans around it): that loop cannot be
+  // capped. Such vertices are kept off the plane and the cut computed again, while that caps
+  // more loops; each round bars at least one more vertex for good, so the rounds end.
+  std::vector<std::int32_t>& barred = scratch().unsnappable;
+  barred.clear();
+  CutComputation first(mesh, plane, options, predicates);
+  CutResult best = first.run();
+  std::vector<std::int32_t> pinched = first.pinched_snaps();
+  for (int round = 0; round < 8 && !pinched.empty() && best.capped_loops < best.loops; ++round) {
+    const std::size_t before = barred.size();
+    barred.insert(barred.end(), pinched.begin(), pinched.end());
+    std::sort(barred.begin(), barred.end());
+    barred.erase(std::unique(barred.begin(), barred.end()), barred.end());
+    if (barred.size() == before) break;
+    CutComputation again(mesh, plane, options, predicates);
+    CutResult next = again.run();
+    if (next.status != CutStatus::Cut || next.capped_loops <= best.capped_loops) break;
+    next.unsnapped_vertices = std::int32_t(barred.size());
+    best = std::move(next);
+    pinched = again.pinched_snaps();
+  }
+  barred.clear();
+  return best;
 }
 
 }  // namespace detail
