@@ -77,6 +77,12 @@ class Character final : public Scene {
     units_ = model.number("units_per_metre", 1, 1e-6, 1e6);
     import_.strict_weights = model.boolean("strict_weights", false);
     weld_ = model.boolean("weld", true);
+    // Seam copies whose bone weights differ: welded with their mean weights (closed seams), or
+    // kept apart as the file has them (mesh/weld.hpp).
+    import_.weld_options.differing_weights =
+        model.text("seam_weights", "mean", {"mean", "keep_apart"}) == "mean"
+            ? mesh::DifferingWeights::mean
+            : mesh::DifferingWeights::keep_apart;
     import_.isolate = true;  // a corrupt file must not kill or corrupt the run
     import_.weld = false;    // welded here, to keep the file's seams for the gap measure
     model.finish();
@@ -225,6 +231,8 @@ class Character final : public Scene {
                 {"positions", seams.positions()},
                 {"open_positions", seams.open_positions()},
                 {"merged_vertices", weld.merged},
+                {"mean_weight_positions", std::int64_t(weld.averaged.size())},
+                {"kept_apart_vertices", weld.kept_apart},
                 // The largest distance, over the run, between body vertices standing for file
                 // vertices at one rest position, relative to the bind pose's bounding-box diagonal.
                 {"max_gap_rel", s.worst_seam_gap},

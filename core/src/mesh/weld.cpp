@@ -62,12 +62,15 @@ void match(const SkinnedMesh& mesh, const WeldOptions& options, std::span<const 
   const double extent = std::max(rest_diagonal(mesh), mesh.rest.cwiseAbs().maxCoeff());
   Grid grid{std::max({tolerance, extent * 1e-8, 1e-300}), {}};
   const bool skin = mesh.bones.cols() == nv && mesh.weights.cols() == nv;
+  const bool mean = options.differing_weights == DifferingWeights::mean;
   result.vertex_map.assign(static_cast<std::size_t>(nv), -1);
+  std::vector<std::uint8_t> differs(static_cast<std::size_t>(nv), 0);  // kept vertex → mean
   for (std::int32_t v = 0; v < nv; ++v) {
     const Eigen::Vector3d p = mesh.rest.col(v);
     const Eigen::Array3i k = grid.key(p);
     std::int32_t into = -1;
     bool near = false;
+    double difference = 0;  // of the weights of `into`
     for (int dx = -1; dx <= 1; ++dx)
       for (int dy = -1; dy <= 1; ++dy)
         for (int dz = -1; dz <= 1; ++dz) {
@@ -77,19 +80,71 @@ void match(const SkinnedMesh& mesh, const WeldOptions& options, std::span<const 
             if (!group.empty() && group[std::size_t(r)] != group[std::size_t(v)]) continue;
             if ((mesh.rest.col(r) - p).norm() > tolerance) continue;
             near = true;
-            if (skin && weight_difference(mesh, r, v) > options.weight_tolerance) continue;
-            if (into < 0 || r < into) into = r;
+            const double d = skin ? weight_difference(mesh, r, v) : 0;
+            if (d > options.weight_tolerance && !mean) continue;
+            if (into < 0 || r < into) into = r, difference = d;
           }
         }
     if (into >= 0) {
       result.vertex_map[std::size_t(v)] = into;
       ++result.merged;
+      if (difference > options.weight_tolerance) {
+        differs[std::size_t(into)] = 1;
+        result.largest_weight_difference = std::max(result.largest_weight_difference, difference);
+      }
     } else {
       result.vertex_map[std::size_t(v)] = v;
       result.kept_apart += near;
       grid.cells[k].push_back(v);
     }
   }
+  for (std::int32_t v = 0; v < nv; ++v)
+    if (differs[std::size_t(v)]) result.averaged.push_back(v);  // old ids, for now
+}
+
+// The mean of the influences of the vertices `copies`: per bone, the mean weight; the
+// kMaxInfluences largest kept (ties: lower bone), scaled to the copies' mean weight sum.
+void mean_influences(SkinnedMesh& mesh, std::int32_t into,
+                     const std::vector<std::int32_t>& copies) {
+  std::vector<std::pair<std::int32_t, double>> sum;  // (bone, summed weight)
+  double total = 0;
+  for (const std::int32_t c : copies)
+    for (int j = 0; j < kMaxInfluences; ++j) {
+      const double w = mesh.weights(j, c);
+      if (w == 0) continue;
+      total += w;
+      const std::int32_t bone = mesh.bones(j, c);
+      auto it =
+          std::find_if(sum.begin(), sum.end(), [&](const auto& e) { return e.first == bone; });
+      if (it == sum.end())
+        sum.push_back({bone, w});
+      else
+        it->second += w;
+    }
+  std::sort(sum.begin(), sum.end(), [](const auto& a, const auto& b) {
+    return a.second > b.second || (a.second == b.second && a.first < b.first);
+  });
+  if (sum.size() > std::size_t(kMaxInfluences)) sum.resize(std::size_t(kMaxInfluences));
+  double kept = 0;
+  for (const auto& e : sum) kept += e.second;
+  const double scale = kept > 0 ? total / kept / double(copies.size()) : 0;
+  for (int j = 0; j < kMaxInfluences; ++j) {
+    const bool used = std::size_t(j) < sum.size();
+    mesh.bones(j, into) = used ? sum[std::size_t(j)].first : 0;
+    mesh.weights(j, into) = used ? sum[std::size_t(j)].second * scale : 0;
+  }
+}
+
+// The welded vertices whose copies' weights differ take their mean (old indices still).
+void average_differing_weights(SkinnedMesh& mesh, const WeldResult& result) {
+  if (result.averaged.empty()) return;
+  std::unordered_map<std::int32_t, std::vector<std::int32_t>> copies;
+  for (const std::int32_t v : result.averaged) copies[v] = {};
+  for (std::int32_t v = 0; v < mesh.vertex_count(); ++v) {
+    const auto it = copies.find(result.vertex_map[std::size_t(v)]);
+    if (it != copies.end()) it->second.push_back(v);
+  }
+  for (const std::int32_t v : result.averaged) mean_influences(mesh, v, copies[v]);
 }
 
 // Keeps the columns `kept` (old indices, increasing) of a per-vertex array.
@@ -110,6 +165,7 @@ void compact_vertices(SkinnedMesh& mesh, WeldResult& result) {
       result.kept.push_back(v);
     }
   for (auto& m : result.vertex_map) m = renumber[std::size_t(m)];
+  for (auto& a : result.averaged) a = renumber[std::size_t(a)];
   if (mesh.has_normals()) {  // a kept vertex's normal: its cluster's, summed
     Eigen::Matrix3Xd sum = Eigen::Matrix3Xd::Zero(3, Eigen::Index(result.kept.size()));
     for (std::int32_t v = 0; v < nv; ++v)
@@ -161,6 +217,7 @@ WeldResult weld(SkinnedMesh& mesh, const WeldOptions& options,
   if (!mesh.has_corner_uvs() && !mesh.has_corner_normals()) make_corner_attributes(mesh);
   WeldResult result;
   match(mesh, options, group, result);
+  average_differing_weights(mesh, result);
   compact_vertices(mesh, result);
   compact_faces(mesh, result);
   return result;

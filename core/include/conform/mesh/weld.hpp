@@ -10,11 +10,18 @@
 //   assimp-testmodels: 1e-7 and below weld exactly the bit-equal seam copies; 3e-7 and 1e-6
 //   also weld distinct nearby vertices of X/Testwuson.X and SMD/WusonSMD.smd (10 and 14 edges
 //   then used by more than two faces).
-// - Bone weights. Coincident vertices weld only when their (up to 4) influences agree: the
-//   largest difference of one bone's weight is at most `weight_tolerance` (default 1e-3).
-//   Otherwise they stay apart, so that neither vertex skins differently from the file (the
-//   seam may then open as they deform). Measured: X/Testwuson.X keeps 7 of its 2124 vertices
-//   apart (welding them anyway leaves its 51 pieces), X/BCN_Epileptic.X 1; the other rigged
+// - Bone weights. Coincident vertices whose (up to 4) influences agree (the largest difference
+//   of one bone's weight is at most `weight_tolerance`, default 1e-3) weld as they are: the
+//   kept vertex's influences. Where they differ (a file whose seam copies were weighted
+//   apart), `differing_weights` decides:
+//   - `mean` (default): they weld all the same, and the welded vertex takes the mean of its
+//     copies' influences (per bone; the 4 largest kept, scaled to the copies' mean sum), so
+//     the seam stays closed as the model deforms, where the file's own copies would part.
+//     Each copy then skins to the mean of where the file puts the copies (to first order).
+//   - `keep_apart`: they stay apart, each skinning exactly as in the file (the seam opens as
+//     they deform).
+//   Measured: X/Testwuson.X has 7 such copies of its 2124 vertices (kept apart they part by
+//   0.38 % of its diagonal in the character scene), X/BCN_Epileptic.X 1; the other rigged
 //   models none (mesh_weld_test.cpp).
 // - Greedy and deterministic: vertices are visited in index order and each joins the first
 //   (lowest-index) kept vertex it matches, else is kept itself. Kept vertices keep their
@@ -31,11 +38,15 @@
 
 namespace conform::mesh {
 
+/// What welding does with coincident vertices whose bone weights differ (see above).
+enum class DifferingWeights { mean, keep_apart };
+
 struct WeldOptions {
   /// Relative to the rest positions' bounding-box diagonal.
   double tolerance = 1e-7;
-  /// Largest difference of one bone's weight between two vertices that weld.
+  /// Largest difference of one bone's weight between two vertices that weld as they are.
   double weight_tolerance = 1e-3;
+  DifferingWeights differing_weights = DifferingWeights::mean;
 };
 
 struct WeldResult {
@@ -44,6 +55,8 @@ struct WeldResult {
   std::vector<std::int32_t> kept;        // new vertex → the old vertex it keeps
   std::int32_t merged = 0;               // vertices welded into another one
   std::int32_t kept_apart = 0;           // vertices left apart at a welded position (weights)
+  std::vector<std::int32_t> averaged;    // new vertices given their copies' mean weights
+  double largest_weight_difference = 0;  // between copies welded with their mean weights
   std::int32_t collapsed_faces = 0;
 };
 
