@@ -2,8 +2,8 @@
 # Builds everything and runs the whole test suite with ctest.
 #
 # Under CI (CI=true), or when asked locally, more configurations run after the main one:
-#   - ASan+UBSan build (leak checks) of the core, import-isolation, lifetime and soak tests;
-#     the whole suite with CONFORM_SANITIZE_ALL=1         CONFORM_SANITIZE_TESTS=1 / CONFORM_SKIP_SANITIZE=1
+#   - ASan+UBSan build (leak checks) of the whole suite   CONFORM_SANITIZE_TESTS=1 / CONFORM_SKIP_SANITIZE=1
+#     (CONFORM_SANITIZE_ALL=0: only the core, import-isolation, lifetime and soak tests)
 #   - Debian's double-precision Bullet: plugin tests and   CONFORM_DOUBLE_TESTS=1   / CONFORM_SKIP_DOUBLE=1
 #     the find_package install test (-DCONFORM_DOUBLE=ON)
 #   - a bounded libFuzzer run of every tests/fuzz target    CONFORM_FUZZ_TESTS=1     / CONFORM_SKIP_FUZZ=1
@@ -24,7 +24,9 @@ if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 werror=OFF
 if [[ "$ci" == "true" ]]; then werror=ON; fi
 
-# Builds the given test targets in a second configuration and runs the tests matching a regex.
+# Builds the given test targets (and those in $extra_targets) in a second configuration and runs
+# the tests matching a regex.
+extra_targets=()
 extra_configuration() {
   local dir="$1" regex="$2" pattern="$3"
   shift 3
@@ -34,7 +36,7 @@ extra_configuration() {
     -DCONFORM_WERROR="$werror" "$@" >"$log" 2>&1 || { cat "$log"; return 1; }
   local targets
   mapfile -t targets < <(cd "$root/tests" && ls $pattern 2>/dev/null | sed 's/\.cpp$//')
-  cmake --build "$dir" --parallel "$jobs" --target conform "${targets[@]}"
+  cmake --build "$dir" --parallel "$jobs" --target conform "${targets[@]}" "${extra_targets[@]}"
   ctest --test-dir "$dir" --output-on-failure --parallel "$jobs" --timeout 900 \
     -R "$regex" -E NOT_BUILT
 }
@@ -60,16 +62,17 @@ if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SA
 fi
 
 # ASan+UBSan with leak detection (tests/sanitizer/lsan.supp: leaks inside third-party libraries
-# only). CI runs the core, import-isolation, lifetime and soak tests there; CONFORM_SANITIZE_ALL=1
-# runs the whole suite (every GoogleTest program and shell test, the install test included).
+# only): the whole suite (every GoogleTest program and shell test, the install test included);
+# CONFORM_SANITIZE_ALL=0 runs only the core, import-isolation, lifetime and soak tests.
 # CONFORM_SANITIZED=1 tells the few tests that size themselves to run smaller.
 if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SANITIZE_TESTS:-0}" == "1" ) ]]; then
   sanitize_start=$SECONDS
   sanitized_regex='^(cga_|ik_|skin_alloc_test|io_broken_test|plugin_lifetime_test|plugin_soak_test)'
   sanitized_sources='cga_*_test.cpp ik_*_test.cpp skin_alloc_test.cpp io_broken_test.cpp plugin_lifetime_test.cpp plugin_soak_test.cpp'
-  if [[ "${CONFORM_SANITIZE_ALL:-0}" == "1" ]]; then
+  if [[ "${CONFORM_SANITIZE_ALL:-1}" == "1" ]]; then
     sanitized_regex='.'
     sanitized_sources='*_test.cpp'
+    extra_targets=(model_wire_replay scene_replay mesh_ops_replay)  # the fuzz regressions' ctests
   fi
   echo "conform: tests under ASan+UBSan ($sanitized_regex)"
   ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS="suppressions=$root/tests/sanitizer/lsan.supp" \
@@ -77,6 +80,7 @@ if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SA
     extra_configuration "$build-sanitize" "$sanitized_regex" "$sanitized_sources" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCONFORM_SANITIZE=ON
   echo "conform: the sanitized stage took $((SECONDS - sanitize_start)) s"
+  extra_targets=()
 fi
 
 if [[ "${CONFORM_SKIP_DOUBLE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_DOUBLE_TESTS:-0}" == "1" ) ]]; then
