@@ -176,28 +176,31 @@ std::array<double, 3> place_tip(const std::array<double, 3>& bary, const Eigen::
 }
 
 // Step 6's direction at each interior path point: Π's normal of the step that made it (toward
-// the left side) without its component along the path, averaged with its neighbours'. Π
-// leans along the path where the tip was off the blade's track, and an opening along it moves
-// a point past its neighbours (lips that zigzag).
+// the left side), averaged along the path with Gaussian weights exp(−Δs² / 2σ²) of the arc
+// length between points, without its component along the path's tangent (averaged alike).
+// Π leans along the path where the tip was off the blade's track, and a direction that turns
+// faster than the opening is wide folds one lip over itself where the path bends: an offset
+// curve loops once its offset exceeds the radius of curvature. With σ at least the opening's
+// width, each lip is an offset of the path smoothed over σ.
 std::vector<Eigen::Vector3d> opening_directions(const std::vector<Eigen::Vector3d>& points,
-                                                const std::vector<Eigen::Vector3d>& normals) {
+                                                const std::vector<Eigen::Vector3d>& normals,
+                                                double sigma) {
   const std::size_t n = points.size();
-  std::vector<Eigen::Vector3d> across(normals);
-  auto tangent = [&](std::size_t i) {
-    return Eigen::Vector3d(points[std::min(i + 1, n - 1)] - points[i > 0 ? i - 1 : 0]).normalized();
-  };
-  for (std::size_t i = 1; i + 1 < n; ++i) {
-    const Eigen::Vector3d t = tangent(i);
-    if (t.allFinite()) across[i] -= across[i].dot(t) * t;
-  }
+  std::vector<double> s(n, 0.0);
+  for (std::size_t i = 1; i < n; ++i) s[i] = s[i - 1] + (points[i] - points[i - 1]).norm();
   std::vector<Eigen::Vector3d> out(normals);
   for (std::size_t i = 1; i + 1 < n; ++i) {
-    Eigen::Vector3d d = 2 * across[i];
-    if (i > 1) d += across[i - 1];
-    if (i + 2 < n) d += across[i + 1];
-    const Eigen::Vector3d t = tangent(i);
+    Eigen::Vector3d d = Eigen::Vector3d::Zero(), t = Eigen::Vector3d::Zero();
+    for (std::size_t j = 0; j < n; ++j) {
+      const double u = (s[j] - s[i]) / sigma;
+      if (std::abs(u) > 4) continue;
+      const double w = std::exp(-0.5 * u * u);
+      d += w * normals[j];
+      if (j + 1 < n) t += w * (points[j + 1] - points[j]);  // the segment's direction × length
+    }
+    if (t.norm() > 0) t.normalize();
     if (t.allFinite()) d -= d.dot(t) * t;
-    if (d.norm() > 1e-6 * across[i].norm() && d.allFinite()) out[i] = d.normalized();
+    if (d.norm() > 1e-6 && d.allFinite()) out[i] = d.normalized();
   }
   return out;
 }
@@ -363,6 +366,10 @@ class TearAdvance {
       tear_.message_ = "the blade has not moved away from the tip";
       return false;
     }
+    if (blade_behind_a_leading_tip()) {
+      tear_.message_ = "the blade has not caught up with the tip: waiting for it";
+      return false;
+    }
     for (const Move& m : first) {
       if (!path_.empty()) break;
       if (m.cosine <= 0) break;
@@ -406,6 +413,15 @@ class TearAdvance {
       return false;
     }
     return false;
+  }
+
+  // A tip put ahead of the blade's hit (on the edge crossing past it, TearOptions::smooth_lips)
+  // and a blade still behind it: a walk toward the blade would turn the path back on itself.
+  bool blade_behind_a_leading_tip() const {
+    const auto& path = tear_.path_;
+    if (!tear_.options_.smooth_lips || path.size() < 2) return false;
+    const Eigen::Vector3d along = tip_ - mesh_.current.col(path[path.size() - 2].right);
+    return (tear_.tip_target_ - tip_).dot(along) < 0 && toward_.dot(along) < 0;
   }
 
   // The walk that leaves the tip by move m; on reaching the blade it becomes the path.
@@ -528,7 +544,8 @@ class TearAdvance {
     split_.base_face_count = mesh_.face_count();
     const bool smooth = tear_.options_.smooth_lips;
     const PathPoint blade = path_.back().out;
-    if (!(smooth && split_with_tip_on_edge(kLipBehind))) {
+    if (!(smooth && (split_with_tip_on_edge(kLipBehind) ||
+                     (tip_shift(path_.back()) > kLipShift && split_with_nearer_crossing())))) {
       restart_split();
       points_.push_back(tear_.tip_);
       for (std::size_t i = 0; i < path_.size(); ++i) {
@@ -583,13 +600,27 @@ class TearAdvance {
   static constexpr double kLipBehind = 0.4;
   bool split_with_tip_on_edge(double behind, bool ahead = false) {
     const Crossing& last = path_.back();
-    if (last.out.kind != PathPoint::Inside || !roomy(last.face)) return false;
+    if (last.out.kind != PathPoint::Inside) return false;
     const Eigen::Vector3d hit = pos(last.out, last.face);
     std::vector<Crossing> path = path_;
     PathPoint tip;
     std::int32_t beyond = -1;  // the face split from the tip: not on the rest of the walk
-    if (path.size() >= 2 && last.in.kind == PathPoint::Edge &&
-        (hit - pos(last.in, last.face)).norm() < behind * mean_edge(last.face)) {
+    const bool near = path.size() >= 2 && last.in.kind != PathPoint::Inside &&
+                      (hit - pos(last.in, last.face)).norm() < behind * mean_edge(last.face);
+    if (near && last.in.kind == PathPoint::Vertex) {
+      // The walk reached a vertex beside the blade: the tip stays on it. An inside tip there
+      // would be pushed off the vertex toward the face's middle (its fan), behind the vertex on
+      // the path: a lip that doubles back.
+      path.pop_back();
+      restart_split();
+      points_.push_back(tear_.tip_);
+      for (const Crossing& c : path) split_face(c);
+      path_ = std::move(path);
+      target_ = hit;
+      return true;
+    }
+    if (!roomy(last.face)) return false;
+    if (near) {
       tip = last.in;
       beyond = last.face;
       path.pop_back();  // the path ends at the tip
@@ -624,6 +655,56 @@ class TearAdvance {
     path_ = std::move(path);
     target_ = hit;
     return true;
+  }
+
+  // Where an inside tip at the blade's hit would have to move more than kLipShift of its face's
+  // mean edge toward the face's middle to keep its fan above the floor (place_tip), off the
+  // blade's track, the tip goes on the nearer of the edge crossings behind and ahead of the hit,
+  // within kLipReach of that edge: an edge crossing lies on Π, so on the track. (Every shift is
+  // taken instead at 0.03 or 0.05: the lips turn less on the arm, but the tip waits for the
+  // blade more often on huesitos.fbx.)
+  static constexpr double kLipReach = 0.6, kLipShift = 0.1;
+  bool split_with_nearer_crossing() {
+    const Crossing& last = path_.back();
+    const Eigen::Vector3d hit = pos(last.out, last.face);
+    const double inf = std::numeric_limits<double>::infinity();
+    const double reach = kLipReach * mean_edge(last.face);
+    PathPoint exit;
+    const double back = last.in.kind != PathPoint::Inside && path_.size() >= 2
+                            ? (hit - pos(last.in, last.face)).norm()
+                            : inf;
+    const double ahead = exit_ahead(last, hit, exit) ? (pos(exit, last.face) - hit).norm() : inf;
+    if (std::min(back, ahead) > reach) return false;
+    if (ahead < back)
+      return split_with_tip_on_edge(0, true) || (back <= reach && split_with_tip_on_edge(inf));
+    return split_with_tip_on_edge(inf) || (ahead <= reach && split_with_tip_on_edge(0, true));
+  }
+
+  // The polygon around a new tip in crossing c's face: its corners, with the path's edge point.
+  std::vector<Eigen::Vector3d> tip_ring(const Crossing& c) const {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
+    std::vector<Eigen::Vector3d> ring;
+    for (int k = 0; k < 3; ++k) {
+      ring.push_back(mesh_.current.col(f[k]));
+      if (c.in.kind == PathPoint::Edge && on_edge(c.in, f[k], f[(k + 1) % 3]))
+        ring.push_back(pos(c.in, c.face));
+    }
+    return ring;
+  }
+
+  // How far (in mean edges of its face) place_tip would move an inside tip at crossing c's hit,
+  // toward the face's middle, to keep its fan above the floor: 0 for any other crossing.
+  double tip_shift(const Crossing& c) const {
+    if (c.out.kind != PathPoint::Inside) return 0;
+    const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
+    const Eigen::Vector3d fa = mesh_.current.col(f[0]), fb = mesh_.current.col(f[1]),
+                          fc = mesh_.current.col(f[2]);
+    const std::vector<Eigen::Vector3d> ring = tip_ring(c);
+    const double min_angle = tear_.options_.min_angle;
+    const auto w = place_tip(c.out.bary, fa, fb, fc, ring, min_angle, nullptr,
+                             std::pow(std::sin(min_angle), 2));
+    const Eigen::Vector3d moved = w[0] * fa + w[1] * fb + w[2] * fc;
+    return (moved - pos(c.out, c.face)).norm() / mean_edge(c.face);
   }
 
   // A face whose corners, split once more, keep the sliver floor (smallest angle ≥ 2 min_angle):
@@ -672,12 +753,7 @@ class TearAdvance {
     const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
     const Eigen::Vector3d fa = mesh_.current.col(f[0]), fb = mesh_.current.col(f[1]),
                           fc = mesh_.current.col(f[2]);
-    std::vector<Eigen::Vector3d> ring;
-    for (int k = 0; k < 3; ++k) {
-      ring.push_back(mesh_.current.col(f[k]));
-      if (c.in.kind == PathPoint::Edge && on_edge(c.in, f[k], f[(k + 1) % 3]))
-        ring.push_back(pos(c.in, c.face));
-    }
+    const std::vector<Eigen::Vector3d> ring = tip_ring(c);
     target_ = pos(c.out, c.face);
     // Aim at the floor itself. A face the tear made (it holds a vertex the tear added), e.g.
     // in the old tip's fan after a short step, whose fan cannot keep the floor is not split:
@@ -976,7 +1052,8 @@ std::vector<std::pair<std::int32_t, Eigen::Vector3d>> Tear::open(double amount) 
   if (options_.smooth_lips) {
     std::vector<Eigen::Vector3d> points;
     for (const auto& p : path_) points.push_back(mesh_.current.col(p.right));
-    direction = opening_directions(points, direction);
+    const double mean_segment = total / static_cast<double>(path_.size() - 1);
+    direction = opening_directions(points, direction, std::max(amount, mean_segment));
   }
   std::vector<Eigen::Vector3d> delta(path_.size(), Eigen::Vector3d::Zero());
   double s = 0;
