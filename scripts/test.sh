@@ -33,7 +33,7 @@ extra_configuration() {
   local log
   log="$(mktemp)"
   cmake -S "$root" -B "$dir" "${generator[@]}" -DCONFORM_BUILD_BENCHMARKS=OFF \
-    -DCONFORM_WERROR="$werror" "$@" >"$log" 2>&1 || { cat "$log"; return 1; }
+    -DCONFORM_WERROR="${stage_werror:-$werror}" "$@" >"$log" 2>&1 || { cat "$log"; return 1; }
   local targets
   mapfile -t targets < <(cd "$root/tests" && ls $pattern 2>/dev/null | sed 's/\.cpp$//')
   cmake --build "$dir" --parallel "$jobs" --target conform "${targets[@]}" "${extra_targets[@]}"
@@ -78,7 +78,9 @@ if [[ "${CONFORM_SKIP_SANITIZE:-0}" != "1" && ( "$ci" == "true" || "${CONFORM_SA
     extra_targets=(model_wire_replay scene_replay mesh_ops_replay)  # the fuzz regressions' ctests
   fi
   echo "conform: tests under ASan+UBSan ($sanitized_regex)"
-  ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS="suppressions=$root/tests/sanitizer/lsan.supp" \
+  # Warnings are the main build's errors (-Werror at -O3 there); GCC's flow-based warnings differ
+  # at -O1 with sanitizer instrumentation, and they are not what this stage checks.
+  stage_werror=OFF ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS="suppressions=$root/tests/sanitizer/lsan.supp" \
     UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 CONFORM_SANITIZED=1 \
     extra_configuration "$build-sanitize" "$sanitized_regex" "$sanitized_sources" \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
