@@ -607,22 +607,15 @@ class TearAdvance {
     std::int32_t beyond = -1;  // the face split from the tip: not on the rest of the walk
     const bool near = path.size() >= 2 && last.in.kind != PathPoint::Inside &&
                       (hit - pos(last.in, last.face)).norm() < behind * mean_edge(last.face);
-    if (near && last.in.kind == PathPoint::Vertex) {
-      // The walk reached a vertex beside the blade: the tip stays on it. An inside tip there
-      // would be pushed off the vertex toward the face's middle (its fan), behind the vertex on
-      // the path: a lip that doubles back.
-      path.pop_back();
-      restart_split();
-      points_.push_back(tear_.tip_);
-      for (const Crossing& c : path) split_face(c);
-      path_ = std::move(path);
-      target_ = hit;
-      return true;
-    }
-    if (!roomy(last.face)) return false;
+    // Past a vertex the walk reached, the tip stays on it and no face is split beyond: an inside
+    // tip there would be pushed off the vertex toward the face's middle (its fan), behind the
+    // vertex on the path, a lip that doubles back. Past an edge crossing, the blade's face is
+    // split from its vertex opposite that edge, which needs a roomy face.
+    const bool at_vertex = near && last.in.kind == PathPoint::Vertex;
+    if (!at_vertex && !roomy(last.face)) return false;
     if (near) {
       tip = last.in;
-      beyond = last.face;
+      if (!at_vertex) beyond = last.face;
       path.pop_back();  // the path ends at the tip
     } else if (ahead && exit_ahead(last, hit, tip)) {
       path.back().out = tip;
@@ -642,10 +635,12 @@ class TearAdvance {
       split_face(path[i]);
     }
     if (path.size() < path_.size()) first_checked = split_.added_faces.size();
-    if (std::find(split_.removed_faces.begin(), split_.removed_faces.end(), beyond) !=
-        split_.removed_faces.end())
-      return false;
-    split_from_opposite(beyond, tip);
+    if (beyond >= 0) {
+      if (std::find(split_.removed_faces.begin(), split_.removed_faces.end(), beyond) !=
+          split_.removed_faces.end())
+        return false;
+      split_from_opposite(beyond, tip);
+    }
     const double floor2 = std::pow(std::sin(tear_.options_.min_angle), 2);
     for (std::size_t i = first_checked; i < split_.added_faces.size(); ++i) {
       const Face& f = split_.added_faces[i];
