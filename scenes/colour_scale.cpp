@@ -19,18 +19,6 @@ Rgb ColourScale::operator()(double value) const {
   return {stops.back()[1], stops.back()[2], stops.back()[3]};
 }
 
-std::string ColourScale::gnuplot_palette() const {
-  std::string out = "set palette defined (";
-  char buf[96];
-  for (std::size_t i = 0; i < stops.size(); ++i) {
-    // gnuplot's positions are in cbrange units when cbrange is set: map [0, 1] onto it.
-    std::snprintf(buf, sizeof buf, "%s%.9g %.4f %.4f %.4f", i ? ", " : "",
-                  min + stops[i][0] * (max - min), stops[i][1], stops[i][2], stops[i][3]);
-    out += buf;
-  }
-  return out + ")";
-}
-
 ColourScale make_scale(const std::string& scalar, std::span<const double> values, double range) {
   ColourScale s;
   // A high percentile rather than the largest value: a few stretched slivers at a blade's tip

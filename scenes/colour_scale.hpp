@@ -1,5 +1,5 @@
 // The colour scale of the pictures and of the glTF's vertex colours: a piecewise-linear map
-// from a scalar range to RGB, the same stops written into the gnuplot colour bar, and the
+// from a scalar range to RGB, the same stops drawn as the pictures' colour bar, and the
 // wound bed's colour (the inside of the skin), which no value of the scale takes.
 #pragma once
 
@@ -21,8 +21,6 @@ struct ColourScale {
   std::vector<std::array<double, 4>> stops;  // (position in [0, 1], r, g, b), increasing
 
   Rgb operator()(double value) const;
-  /// gnuplot's `set palette defined (...)` with the same stops.
-  std::string gnuplot_palette() const;
 };
 
 /// The scale of a scalar ("stretch": diverging blue - skin - orange, symmetric about 0;

@@ -77,4 +77,25 @@ Camera aim_camera(std::span<const FrameSnapshot> panels, const RenderCamera& s, 
   return c;
 }
 
+StripCamera strip_camera(const Camera& panel, double aspect, double max_parallax_deg) {
+  const double deg = std::numbers::pi / 180;
+  Eigen::Vector3d back = panel.position - panel.target;
+  const double d = std::max(back.norm(), 1e-9);
+  back /= d;
+  Eigen::Vector3d right = (-back).cross(panel.up);
+  if (right.norm() < 1e-9) right = back.unitOrthogonal();
+  right.normalize();
+  // One panel's width at the target: 2 d tan(a/2) aspect. From s times as far, with
+  // tan(a'/2) = tan(a/2) / s, the target's framing is the same, and the next panel, a width
+  // away, is seen at atan(width / (s d)) from the first: at most max_parallax_deg.
+  const double half = std::tan(0.5 * panel.view_angle * deg);
+  const double width = 2 * d * half * aspect;
+  const double s = std::max(1.0, width / (d * std::tan(max_parallax_deg * deg)));
+  StripCamera strip{panel, width * right};
+  strip.camera.position = panel.target + s * d * back;
+  strip.camera.view_angle = 2 * std::atan(half / s) / deg;
+  strip.camera.up = back.cross(right);  // the panel's up, made square to the view
+  return strip;
+}
+
 }  // namespace conform::scenes

@@ -1,20 +1,17 @@
-// Pictures of a run: chosen frames rendered by a real renderer (Debian's f3d, under a virtual
-// X display from xvfb-run when there is no display), the runs of one frame side by side with
-// the same camera (event_camera.hpp), coloured by a scalar (colour_scale.hpp) with a colour bar
-// and a title (gnuplot composes them), the inside of the skin as a wound bed, and a short video
-// of the pictures (ffmpeg).
+// Pictures of a run: chosen frames rendered by a real renderer (Debian's f3d, on a virtual X
+// display of conform's own when there is none, virtual_display.hpp), the runs of one frame side
+// by side with the same camera (event_camera.hpp), coloured by a scalar (colour_scale.hpp) with
+// a colour bar and a title (composed with cairo, picture_compose.hpp), the inside of the skin as
+// a wound bed, and a short video of the pictures (ffmpeg).
 //
-// The wound bed: every panel's surface is drawn twice, as it is and as an inner layer moved a
-// skin's thickness inwards with its faces turned (so that it faces the inside) in the wound
-// bed's colour. From outside the skin hides it; through an open wound it is what one sees,
-// instead of the far inner wall of a hollow limb.
+// The wound bed and the panels side by side: strip_mesh.hpp.
 //
 // Written into the run folder:
 //   pictures/step_STEP.png        the side-by-side picture of one frame
-//   pictures/panels/NAME_STEP.png one run's panel as f3d rendered it
-//   pictures/render.sh, compose.gp the scripts that made them (re-runnable by hand)
+//   pictures/panels/strip_STEP.png the frame's panels side by side as f3d rendered them
+//   pictures/render.sh            the f3d script that made the panels (re-runnable by hand)
 //   run.gif or run.mp4            the pictures in turn (when there are 2 or more)
-// A missing tool (f3d, xvfb-run, gnuplot, ffmpeg) is a warning, never a failed run.
+// A missing tool (f3d, Xvfb, ffmpeg) is a warning, never a failed run.
 #pragma once
 
 #include <filesystem>
@@ -25,6 +22,7 @@
 #include "frame_snapshot.hpp"
 #include "render_settings.hpp"
 #include "scene_config.hpp"
+#include "virtual_display.hpp"
 
 namespace conform::scenes {
 
@@ -56,6 +54,7 @@ class PictureRenderer {
   std::string title_;
   std::vector<std::vector<FrameSnapshot>> frames_;
   std::unique_ptr<Pending> pending_;
+  std::unique_ptr<VirtualDisplay> display_;  // when conform has no display of its own
   bool started_ = false;
 };
 

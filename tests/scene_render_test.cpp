@@ -4,10 +4,12 @@
 // colour shows through the open wound only once it is open, run.glb reads back through assimp
 // with each frame's vertex and face counts of the PLY frames (read by assimp too), and f3d opens
 // it. A run without f3d on PATH still succeeds, with a warning. The renders need f3d, xvfb and
-// ffmpeg (scripts/deps.sh); conform starts xvfb-run itself when there is no display.
+// ffmpeg (scripts/deps.sh); conform starts its own Xvfb when there is no display, and a killed
+// run leaves none behind.
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -60,10 +62,12 @@ std::array<int, 2> png_size(const fs::path& p) {
   return {be(16), be(20)};
 }
 
-// The pixels as RGB bytes, decoded by ffmpeg (an independent decoder).
-std::vector<unsigned char> pixels(const fs::path& p) {
-  const std::string cmd =
-      "ffmpeg -loglevel error -i " + p.string() + " -f rawvideo -pix_fmt rgb24 -";
+// The pixels as RGB bytes, decoded by ffmpeg (an independent decoder); `crop` ("w:h:x:y"),
+// when given, cuts a rectangle out first.
+std::vector<unsigned char> pixels(const fs::path& p, const std::string& crop = "") {
+  const std::string cmd = "ffmpeg -loglevel error -i " + p.string() +
+                          (crop.empty() ? "" : " -vf crop=" + crop) +
+                          " -f rawvideo -pix_fmt rgb24 -";
   std::vector<unsigned char> out;
   FILE* f = popen(cmd.c_str(), "r");
   if (!f) return out;
@@ -72,6 +76,12 @@ std::vector<unsigned char> pixels(const fs::path& p) {
     out.insert(out.end(), buf, buf + n);
   pclose(f);
   return out;
+}
+
+// Panel k of a strip (ffmpeg's crop: width:height:x:y).
+std::string panel_crop(int k) {
+  return std::to_string(kWidth) + ":" + std::to_string(kHeight) + ":" + std::to_string(k * kWidth) +
+         ":0";
 }
 
 // Pixels that are not the white background.
@@ -130,11 +140,13 @@ TEST_F(SceneRender, PicturesHaveTheRequestedSizeAndShowTheWound) {
     const fs::path side = run_dir() / "pictures" / ("step_" + std::string(step) + ".png");
     // Two panels, the colour bar's 170 px and the titles' 60 px.
     EXPECT_EQ(png_size(side), (std::array<int, 2>{2 * kWidth + 170, kHeight + 60})) << side;
-    for (const char* run : {"physics", "geometric"}) {
-      const fs::path panel =
-          run_dir() / "pictures" / "panels" / (std::string(run) + "_" + step + ".png");
-      EXPECT_EQ(png_size(panel), (std::array<int, 2>{kWidth, kHeight})) << panel;
-      const auto rgb = pixels(panel);
+    // f3d renders a frame's panels side by side in one strip (physics, then geometric).
+    const fs::path strip =
+        run_dir() / "pictures" / "panels" / ("strip_" + std::string(step) + ".png");
+    EXPECT_EQ(png_size(strip), (std::array<int, 2>{2 * kWidth, kHeight})) << strip;
+    for (int k = 0; k < 2; ++k) {
+      const auto rgb = pixels(strip, panel_crop(k));
+      const fs::path panel = strip.string() + " panel " + std::to_string(k);
       ASSERT_EQ(rgb.size(), std::size_t(3 * kWidth * kHeight)) << panel;
       // The arm fills a good part of the frame, not all of it.
       EXPECT_GT(foreground(rgb), kWidth * kHeight / 5) << panel;
@@ -143,9 +155,9 @@ TEST_F(SceneRender, PicturesHaveTheRequestedSizeAndShowTheWound) {
   }
   // At step 30 the stroke has only begun; at step 60 both wounds are open and the wound bed
   // shows through them.
-  const auto p30 = pixels(run_dir() / "pictures/panels/physics_000030.png");
-  const auto p60 = pixels(run_dir() / "pictures/panels/physics_000060.png");
-  const auto g60 = pixels(run_dir() / "pictures/panels/geometric_000060.png");
+  const auto p30 = pixels(run_dir() / "pictures/panels/strip_000030.png", panel_crop(0));
+  const auto p60 = pixels(run_dir() / "pictures/panels/strip_000060.png", panel_crop(0));
+  const auto g60 = pixels(run_dir() / "pictures/panels/strip_000060.png", panel_crop(1));
   EXPECT_LT(wound_bed(p30), 20);
   EXPECT_GT(wound_bed(p60), 100);
   EXPECT_GT(wound_bed(g60), 50);
@@ -162,6 +174,41 @@ TEST_F(SceneRender, PicturesHaveTheRequestedSizeAndShowTheWound) {
     }
   EXPECT_GT(differ_centre, 100);
   EXPECT_GT(differ_centre, differ_edge);
+}
+
+TEST_F(SceneRender, PictureHoldsTheStripAndAColourBar) {
+  ASSERT_EQ(rc_, 0);
+  const int width = 2 * kWidth + 170, height = kHeight + 60;
+  const auto picture = pixels(run_dir() / "pictures/step_000060.png");
+  const auto strip = pixels(run_dir() / "pictures/panels/strip_000060.png");
+  ASSERT_EQ(picture.size(), std::size_t(3 * width * height));
+  ASSERT_EQ(strip.size(), std::size_t(3 * 2 * kWidth * kHeight));
+  // The strip is pasted as it is, 60 px down (the titles above it).
+  int differ = 0;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < 2 * kWidth; ++x)
+      for (int c = 0; c < 3; ++c)
+        differ += picture[std::size_t(3 * ((y + 60) * width + x) + c)] !=
+                  strip[std::size_t(3 * (y * 2 * kWidth + x) + c)];
+  EXPECT_EQ(differ, 0);
+  // The colour bar (22 px wide, 20 px right of the panels, from 10 % to 80 % of the panel
+  // height): the stretch scale's ends, orange at the top and blue at the bottom.
+  const auto at = [&](int x, int y) {
+    const std::size_t i = std::size_t(3 * (y * width + x));
+    return std::array<int, 3>{picture[i], picture[i + 1], picture[i + 2]};
+  };
+  const int bar_x = 2 * kWidth + 31;
+  const auto top = at(bar_x, 60 + int(0.10 * kHeight) + 3);
+  const auto bottom = at(bar_x, 60 + int(0.80 * kHeight) - 3);
+  EXPECT_GT(top[0], 200) << "top of the bar";  // orange (0.95, 0.55, 0.05)
+  EXPECT_LT(top[2], 80) << "top of the bar";
+  EXPECT_LT(bottom[0], 80) << "bottom of the bar";  // blue (0.15, 0.30, 0.80)
+  EXPECT_GT(bottom[2], 170) << "bottom of the bar";
+  // The title and the panel names are drawn: dark pixels in the top margin.
+  int ink = 0;
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 2 * kWidth; ++x) ink += at(x, y)[0] < 100;
+  EXPECT_GT(ink, 100);
 }
 
 TEST_F(SceneRender, VideoIsAGif) {
@@ -228,6 +275,50 @@ TEST(SceneRenderOff, NoRenderWritesNoPicturesAndNoGlb) {
   EXPECT_FALSE(fs::exists(out / "pictures"));
   EXPECT_FALSE(fs::exists(out / "run.glb"));
   EXPECT_TRUE(fs::exists(out / "frames" / "physics_000060.ply"));
+}
+
+// Without a display conform starts its own Xvfb when the run begins (virtual_display.hpp); a
+// run killed while it lives must not leave it behind.
+TEST(SceneRenderDisplay, AKilledRunLeavesNoXvfbBehind) {
+  const fs::path out =
+      fs::temp_directory_path() / ("conform_scene_render_kill_" + std::to_string(::getpid()));
+  fs::remove_all(out);
+  const fs::path conform = fs::path(CONFORM_BINARY_DIR) / "scenes" / "conform";
+  const std::string cmd = "env -u DISPLAY " + conform.string() +
+                          " run tear-opening --steps 100000 --set outputs.plots=false --out " +
+                          out.string() + " > /dev/null 2>&1 & echo $!";
+  FILE* f = popen(cmd.c_str(), "r");
+  ASSERT_NE(f, nullptr);
+  int run = 0;
+  ASSERT_EQ(std::fscanf(f, "%d", &run), 1);
+  pclose(f);
+  const auto first_line = [](const std::string& c) {
+    FILE* p = popen(c.c_str(), "r");
+    char buf[64] = {0};
+    if (p && !std::fgets(buf, sizeof buf, p)) buf[0] = 0;
+    if (p) pclose(p);
+    return std::string(buf);
+  };
+  // Its Xvfb child, once started.
+  int xvfb = 0;
+  for (int i = 0; i < 200 && xvfb == 0; ++i) {
+    xvfb = std::atoi(first_line("pgrep -P " + std::to_string(run) + " -x Xvfb").c_str());
+    if (xvfb == 0) usleep(50000);
+  }
+  ::kill(run, SIGKILL);
+  ASSERT_GT(xvfb, 0) << "the run started no Xvfb";
+  // Gone (or a zombie waiting for its new parent to reap it) within 5 s.
+  const auto alive = [&] {
+    const std::string stat = read_text("/proc/" + std::to_string(xvfb) + "/stat");
+    const auto close = stat.rfind(')');
+    return close != std::string::npos && close + 2 < stat.size() && stat[close + 2] != 'Z';
+  };
+  for (int i = 0; i < 100 && alive(); ++i) usleep(50000);
+  EXPECT_FALSE(alive()) << "Xvfb " << xvfb << " outlived its run";
+  // The killed run's staging folder and lock file (output_folder.hpp).
+  const std::string mine = "." + out.filename().string() + ".";
+  for (const auto& e : fs::directory_iterator(out.parent_path()))
+    if (e.path().filename().string().rfind(mine, 0) == 0) fs::remove_all(e.path());
 }
 
 TEST(SceneRenderOff, MissingF3dIsAWarningNotAFailure) {

@@ -1,0 +1,26 @@
+// The render input of one frame: every panel's coloured surface and its wound bed, moved to
+// its place in the strip (strip_camera) and clipped to its own column of the picture, so that
+// a limb longer than a panel is wide does not reach into its neighbour's.
+//
+// The wound bed: each surface is drawn twice, as it is and as an inner layer moved a skin's
+// thickness inwards with its faces turned (so that it faces the inside) in the wound bed's
+// colour. From outside the skin hides it; through an open wound it is what one sees, instead
+// of the far inner wall of a hollow limb.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "colour_scale.hpp"
+#include "event_camera.hpp"
+#include "frame_snapshot.hpp"
+
+namespace conform::scenes {
+
+/// Writes `frame`'s panels, left to right, as one binary little-endian PLY with per-vertex
+/// colours (f3d reads them as its "RGB" array); `aspect` is one panel's width / height.
+/// Throws std::runtime_error naming `path` when it cannot be written.
+void write_strip_ply(const std::filesystem::path& path, const std::vector<FrameSnapshot>& frame,
+                     const ColourScale& scale, const StripCamera& strip, double aspect);
+
+}  // namespace conform::scenes
