@@ -11,6 +11,7 @@
 #include "colour_scale.hpp"
 #include "event_camera.hpp"
 #include "picture_compose.hpp"
+#include "progress.hpp"
 #include "strip_mesh.hpp"
 #include "virtual_display.hpp"
 
@@ -105,7 +106,9 @@ FILE* launch_panels(const fs::path& pics, const std::vector<std::string>& jobs,
     sh << "#!/bin/sh\n# Drawn by conform: the f3d renders of this run's panels (from the PLY "
           "inputs, removed once rendered).\ncd \"$(dirname \"$0\")\" || exit 1\n";
     for (std::size_t i = 0; i < jobs.size(); ++i)
-      sh << jobs[i] << " &\n" << ((i + 1) % cores == 0 || i + 1 == jobs.size() ? "wait\n" : "");
+      // A line on stdout per rendered frame: conform's progress counts them.
+      sh << "{ " << jobs[i] << " && echo rendered; } &\n"
+         << ((i + 1) % cores == 0 || i + 1 == jobs.size() ? "wait\n" : "");
     if (!sh) {
       warn(report, "cannot write " + (pics / "render.sh").string());
       return nullptr;
@@ -113,7 +116,7 @@ FILE* launch_panels(const fs::path& pics, const std::vector<std::string>& jobs,
   }
   std::string cmd = "sh " + sq((pics / "render.sh").string());
   if (!display.empty()) cmd = "DISPLAY=" + sq(display) + " " + cmd;
-  cmd += " > " + sq((pics / "render.log").string()) + " 2>&1";
+  cmd += " 2> " + sq((pics / "render.log").string());
   FILE* running = ::popen(cmd.c_str(), "r");
   if (!running) warn(report, "cannot start the render script " + (pics / "render.sh").string());
   return running;
@@ -239,7 +242,12 @@ Json PictureRenderer::finish() {
   Pending& p = *pending_;
   Json& report = p.report;
   if (!p.running) return report;
+  Progress bar("pictures", "frame", long(p.frames.size()));
+  char line[64];
+  for (long rendered = 1; std::fgets(line, sizeof line, p.running); ++rendered)
+    bar.update(rendered);
   const int rc = ::pclose(p.running);
+  bar.finish();
   p.running = nullptr;
   if (rc != 0)
     warn(report, "the render script failed (see " + (p.pics / "render.log").string() + ")");

@@ -80,7 +80,6 @@ RunOutput::RunOutput(fs::path dir, const CommonSettings& common)
   fs::create_directories(dir_ / "frames", ec);
   if (ec)
     throw std::runtime_error("cannot create " + (dir_ / "frames").string() + ": " + ec.message());
-  tty_ = ::isatty(STDERR_FILENO) == 1;
   if (common_.render.enabled)
     pictures_ = std::make_unique<PictureRenderer>(common_.render, dir_, common_.name);
   if (common_.render.glb) gltf_ = std::make_unique<GltfSequence>();
@@ -144,14 +143,8 @@ Json RunOutput::finish_render(Clock::time_point t0, double plots_ms, double loop
 }
 
 void RunOutput::progress(int step, int steps) {
-  if (!tty_) return;
-  const int percent = steps > 0 ? (100 * step) / steps : 100;
-  if (percent == last_percent_) return;
-  last_percent_ = percent;
-  const int width = 40, filled = width * percent / 100;
-  std::cerr << "\r" << common_.name << " [" << std::string(static_cast<std::size_t>(filled), '#')
-            << std::string(static_cast<std::size_t>(width - filled), '.') << "] " << percent << "%"
-            << (step >= steps ? "\n" : "") << std::flush;
+  if (!progress_) progress_ = std::make_unique<Progress>(common_.name, "step", steps);
+  progress_->update(step);
 }
 
 namespace {
@@ -242,6 +235,7 @@ std::string first_non_finite(const Json& value, const std::string& key) {
 fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int steps,
                            double simulated_seconds, double loop_seconds) {
   metrics_.reset();  // flush metrics.csv before gnuplot reads it
+  if (progress_) progress_->finish();
   if (const std::string bad = first_non_finite(metrics, ""); !bad.empty())
     throw std::runtime_error("metric " + bad +
                              " is NaN or infinite: the simulation went non-finite");

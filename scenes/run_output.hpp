@@ -15,6 +15,7 @@
 
 #include "conform/mesh/skinned_mesh.hpp"
 #include "frame_snapshot.hpp"
+#include "progress.hpp"
 #include "render_settings.hpp"
 #include "scene_config.hpp"
 
@@ -104,7 +105,7 @@ class RunOutput {
   /// (render_frames.hpp; a no-op with "render": false). Call it beside frame().
   void picture(int step, const std::vector<PicturePanel>& panels);
 
-  /// Progress on stderr, only when it is a terminal.
+  /// Progress on stderr (progress.hpp): a bar on a terminal, plain lines otherwise.
   void progress(int step, int steps);
 
   void add_plot(Plot plot) { plots_.push_back(std::move(plot)); }
@@ -129,8 +130,7 @@ class RunOutput {
   std::unique_ptr<PictureRenderer> pictures_;
   std::unique_ptr<GltfSequence> gltf_;
   int frames_ = 0;
-  bool tty_ = false;
-  int last_percent_ = -1;
+  std::unique_ptr<Progress> progress_;
 };
 
 /// Draws `plot` into dir/NAME.png with gnuplot (the script is kept as dir/NAME.gp); series

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <map>
 
+#include "progress.hpp"
 #include "sweep_point_run.hpp"
 
 namespace conform::scenes {
@@ -17,14 +18,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-class Progress {
+// The sweep's progress: a bar of finished points on a terminal (a failure gets a line of its
+// own above it); otherwise a plain line per finished point on stdout.
+class SweepProgress {
  public:
-  Progress(int total, int skipped) : total_(total), finished_(skipped) {
-    tty_ = ::isatty(STDERR_FILENO) == 1;
+  SweepProgress(int total, int skipped)
+      : tty_(::isatty(STDERR_FILENO) == 1), bar_("sweep", "point", total, 0), finished_(skipped) {
     if (skipped > 0)
       std::cout << "sweep: " << skipped << " of " << total << " points already finished, skipped\n"
                 << std::flush;
-    draw();
+    if (tty_) bar_.update(finished_);
   }
   void report(const SweepPoint& p, const PointStatus& s) {
     ++finished_;
@@ -36,26 +39,18 @@ class Progress {
         (s.state == PointStatus::State::Done
              ? std::string("done in ") + wall
              : "FAILED (exit " + std::to_string(s.exit_code) + "): " + s.error);
-    if (tty_) {
-      // A failure is worth a line of its own above the bar; successes only move the bar.
-      if (s.state == PointStatus::State::Failed) std::cerr << "\r\033[K" << line << "\n";
-    } else {
+    if (!tty_) {
       std::cout << line << "\n" << std::flush;
+      return;
     }
-    draw();
+    if (s.state == PointStatus::State::Failed) bar_.line(line);
+    bar_.update(finished_, failed_ ? std::to_string(failed_) + " failed" : "");
   }
 
  private:
-  void draw() const {
-    if (!tty_) return;
-    const int width = 40, filled = total_ > 0 ? width * finished_ / total_ : width;
-    std::cerr << "\rsweep [" << std::string(std::size_t(filled), '#')
-              << std::string(std::size_t(width - filled), '.') << "] " << finished_ << "/" << total_
-              << (failed_ ? " (" + std::to_string(failed_) + " failed)" : "")
-              << (finished_ >= total_ ? "\n" : "") << std::flush;
-  }
-  int total_, finished_, failed_ = 0;
-  bool tty_ = false;
+  bool tty_;
+  Progress bar_;
+  int finished_, failed_ = 0;
 };
 
 }  // namespace
@@ -70,7 +65,7 @@ PoolResult run_pool(const SweepSpec& spec, const fs::path& dir, int jobs, int on
     else
       todo.push_back(p.index);
   }
-  Progress progress(result.skipped + static_cast<int>(todo.size()), result.skipped);
+  SweepProgress progress(result.skipped + static_cast<int>(todo.size()), result.skipped);
   std::map<pid_t, PointProcess> running;
   std::size_t next = 0;
   while (next < todo.size() || !running.empty()) {

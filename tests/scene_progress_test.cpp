@@ -1,0 +1,77 @@
+// Progress on stderr (scenes/progress.hpp, issue 18 item 4), through the real `conform` command:
+// a run longer than a second shows it, as plain lines (at most one per tenth, the last at
+// 100 %) when stderr is a file and as a bar redrawn in place on a terminal (util-linux's
+// `script` gives the run a pseudo-terminal); a run shorter than a second shows none.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path scratch(const std::string& what) {
+  return fs::temp_directory_path() /
+         ("conform_progress_" + what + "_" + std::to_string(::getpid()));
+}
+
+std::string read_text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// `conform run tear-opening` for `steps` steps, without pictures or plots; returns its stderr.
+std::string run(int steps, bool terminal) {
+  const fs::path out = scratch("out"), err = scratch("err");
+  fs::remove_all(out);
+  const std::string conform = (fs::path(CONFORM_BINARY_DIR) / "scenes" / "conform").string();
+  std::string cmd = conform + " run tear-opening --no-render --set outputs.plots=false --set " +
+                    "outputs.frames_every=0 --steps " + std::to_string(steps) + " --out " +
+                    out.string();
+  // script: the command's stdout and stderr both go to the pseudo-terminal, and from there
+  // to script's stdout.
+  cmd = terminal ? "script -qfec '" + cmd + "' /dev/null > " + err.string() + " 2>&1"
+                 : cmd + " > /dev/null 2> " + err.string();
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const std::string text = read_text(err);
+  fs::remove_all(out);
+  fs::remove(err);
+  return text;
+}
+
+std::vector<std::string> lines_with(const std::string& text, const std::string& part) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string l; std::getline(in, l);)
+    if (l.find(part) != std::string::npos) out.push_back(l);
+  return out;
+}
+
+TEST(Progress, LongRunWritesPlainLinesWhenNotOnATerminal) {
+  // 3,000 steps take a few seconds (about 1 ms a step on the 2-core machine).
+  const std::string err = run(3000, false);
+  const auto lines = lines_with(err, "tear-opening: ");
+  ASSERT_FALSE(lines.empty()) << err;
+  EXPECT_LE(lines.size(), 11u) << err;  // at most one per tenth
+  EXPECT_NE(lines.back().find("100% (step 3000 of 3000"), std::string::npos) << err;
+  EXPECT_EQ(err.find('\r'), std::string::npos) << "no redrawing in a file";
+}
+
+TEST(Progress, ShortRunStaysQuiet) {
+  const std::string err = run(60, false);
+  EXPECT_TRUE(lines_with(err, "% (step").empty()) << err;
+}
+
+TEST(Progress, OnATerminalABarIsRedrawnInPlace) {
+  if (std::system("command -v script > /dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1)";
+  const std::string out = run(3000, true);
+  EXPECT_NE(out.find("\r\033[Ktear-opening ["), std::string::npos) << out;
+  EXPECT_NE(out.find("] 100% (step 3000 of 3000"), std::string::npos) << out;
+}
+
+}  // namespace
