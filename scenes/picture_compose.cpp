@@ -2,6 +2,7 @@
 
 #include <cairo.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -110,7 +111,7 @@ Surface blank(int width, int height) {
 
 }  // namespace
 
-void compose_picture(const fs::path& out, const fs::path& strip,
+void compose_picture(const fs::path& out, const std::vector<fs::path>& renders,
                      const std::vector<std::string>& names, int width, int height,
                      const std::string& title, const ColourScale& scale) {
   const int n = static_cast<int>(names.size());
@@ -119,13 +120,18 @@ void compose_picture(const fs::path& out, const fs::path& strip,
   Context cr(cairo_create(canvas.get()), &cairo_destroy);
   cairo_set_source_rgb(cr.get(), 1, 1, 1);
   cairo_paint(cr.get());
-  const Surface panels = read_png(strip);
-  cairo_save(cr.get());
-  cairo_rectangle(cr.get(), 0, kTop, n * width, height);
-  cairo_clip(cr.get());
-  cairo_set_source_surface(cr.get(), panels.get(), 0, kTop);
-  cairo_paint(cr.get());
-  cairo_restore(cr.get());
+  int x = 0;
+  for (const auto& path : renders) {
+    const Surface render = read_png(path);
+    const int w = cairo_image_surface_get_width(render.get());
+    cairo_save(cr.get());
+    cairo_rectangle(cr.get(), x, kTop, std::min(w, n * width - x), height);
+    cairo_clip(cr.get());
+    cairo_set_source_surface(cr.get(), render.get(), x, kTop);
+    cairo_paint(cr.get());
+    cairo_restore(cr.get());
+    x += w;
+  }
   cairo_set_source_rgb(cr.get(), 0, 0, 0);
   for (int i = 0; i < n; ++i)
     text(cr.get(), names[std::size_t(i)], (i + 0.5) * width, kTop - 8, kNamePt, 0.5);

@@ -20,10 +20,12 @@ struct PictureSize {
 };
 PictureSize picture_size(int panels, int width, int height);
 
-/// Writes the picture of one frame to `out` (PNG) from `strip`, the render of its panels side
-/// by side (each `width` x `height`), with `names[k]` above panel k. Throws std::runtime_error
-/// naming the file that could not be read or written; `out` is then not written.
-void compose_picture(const std::filesystem::path& out, const std::filesystem::path& strip,
+/// Writes the picture of one frame to `out` (PNG) from `renders`, pasted left to right: the
+/// renders of its panels (each `width` x `height`), one strip of all or one per panel, with
+/// `names[k]` above panel k. Throws std::runtime_error naming the file that could not be read
+/// or written; `out` is then not written.
+void compose_picture(const std::filesystem::path& out,
+                     const std::vector<std::filesystem::path>& renders,
                      const std::vector<std::string>& names, int width, int height,
                      const std::string& title, const ColourScale& scale);
 

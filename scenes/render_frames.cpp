@@ -122,6 +122,21 @@ FILE* launch_panels(const fs::path& pics, const std::vector<std::string>& jobs,
   return running;
 }
 
+// The f3d renders of a frame, left to right, as paths under pictures/ without extension: one
+// strip of all its panels, or with "perspective" one per panel.
+std::vector<std::string> renders_of(const std::vector<FrameSnapshot>& frame, bool perspective) {
+  if (!perspective) return {"panels/" + stem("strip", frame.front().step)};
+  std::vector<std::string> out;
+  for (const auto& p : frame) out.push_back("panels/" + stem(p.name, p.step));
+  return out;
+}
+
+std::size_t jobs_count(const std::vector<std::vector<FrameSnapshot>>& frames, bool perspective) {
+  std::size_t n = 0;
+  for (const auto& f : frames) n += renders_of(f, perspective).size();
+  return n;
+}
+
 // The side-by-side pictures (picture_compose.hpp), one per chosen frame.
 bool compose(const fs::path& pics, const std::vector<std::vector<FrameSnapshot>>& frames,
              const RenderSettings& r, const ColourScale& scale, const std::string& title,
@@ -134,9 +149,11 @@ bool compose(const fs::path& pics, const std::vector<std::vector<FrameSnapshot>>
       for (const auto& p : frame) names.push_back(p.name);
       std::snprintf(buf, sizeof buf, "%s, t = %.2f s, coloured by %s", title.c_str(),
                     frame.front().time, r.scalar.c_str());
-      compose_picture(pics / (stem("step", step) + ".png"),
-                      pics / "panels" / (stem("strip", step) + ".png"), names, r.width, r.height,
-                      buf, scale);
+      std::vector<fs::path> renders;
+      for (const auto& name : renders_of(frame, r.perspective))
+        renders.push_back(pics / (name + ".png"));
+      compose_picture(pics / (stem("step", step) + ".png"), renders, names, r.width, r.height, buf,
+                      scale);
     }
   } catch (const std::exception& e) {
     warn(report, e.what());
@@ -184,6 +201,7 @@ struct PictureRenderer::Pending {
   std::vector<std::vector<FrameSnapshot>> frames;
   ColourScale scale{};
   Camera camera{};
+  StripCamera strip{};
   fs::path pics;
   std::vector<fs::path> inputs;
   std::size_t panels = 0;
@@ -212,17 +230,26 @@ void PictureRenderer::start() {
   p.scale = make_scale(settings_.scalar, values, settings_.range);
   const double aspect = double(settings_.width) / settings_.height;
   p.camera = aim_camera(p.frames.back(), settings_.camera, aspect);
-  const StripCamera strip = strip_camera(p.camera, aspect);
+  p.strip = strip_camera(p.camera, aspect);
+  const StripCamera& strip = p.strip;
   p.pics = dir_ / "pictures";
   fs::create_directories(p.pics / "panels");
-  // One f3d render per frame, of all its panels side by side (strip_camera).
+  // One f3d render per frame, of all its panels side by side (strip_camera), or one per panel
+  // through the camera itself.
+  const StripCamera alone{p.camera, Eigen::Vector3d::Zero()};
   std::vector<std::string> jobs;
   for (const auto& f : p.frames) {
-    const std::string s = "panels/" + stem("strip", f.front().step);
-    write_strip_ply(p.pics / (s + ".ply"), f, p.scale, strip, aspect);
-    p.inputs.push_back(p.pics / (s + ".ply"));
-    const int width = settings_.width * static_cast<int>(f.size());
-    jobs.push_back(f3d_command(s + ".ply", s + ".png", width, settings_.height, strip.camera));
+    const auto names = renders_of(f, settings_.perspective);
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      const std::string& s = names[k];
+      const bool one = names.size() > 1;  // a panel alone
+      const std::vector<FrameSnapshot> panels = one ? std::vector{f[k]} : f;
+      write_strip_ply(p.pics / (s + ".ply"), panels, p.scale, one ? alone : strip, aspect);
+      p.inputs.push_back(p.pics / (s + ".ply"));
+      const int width = settings_.width * static_cast<int>(panels.size());
+      jobs.push_back(f3d_command(s + ".ply", s + ".png", width, settings_.height,
+                                 one ? p.camera : strip.camera));
+    }
     p.panels += f.size();
   }
   p.t_render = Clock::now();
@@ -242,7 +269,7 @@ Json PictureRenderer::finish() {
   Pending& p = *pending_;
   Json& report = p.report;
   if (!p.running) return report;
-  Progress bar("pictures", "frame", long(p.frames.size()));
+  Progress bar("pictures", "render", long(jobs_count(p.frames, settings_.perspective)));
   char line[64];
   for (long rendered = 1; std::fgets(line, sizeof line, p.running); ++rendered)
     bar.update(rendered);
@@ -254,13 +281,14 @@ Json PictureRenderer::finish() {
   const double render_ms = ms_since(p.t_render);
   for (const auto& in : p.inputs) fs::remove(in);
   std::size_t missing = 0;
-  for (const auto& f : p.frames) {
-    const fs::path png = p.pics / "panels" / (stem("strip", f.front().step) + ".png");
-    if (!fs::exists(png)) ++missing;
-    fs::remove(png.string() + ".log");
-  }
+  for (const auto& f : p.frames)
+    for (const auto& name : renders_of(f, settings_.perspective)) {
+      const fs::path png = p.pics / (name + ".png");
+      if (!fs::exists(png)) ++missing;
+      fs::remove(png.string() + ".log");
+    }
   if (missing > 0) {
-    warn(report, std::to_string(missing) + " frames were not rendered (see " +
+    warn(report, std::to_string(missing) + " renders are missing (see " +
                      (p.pics / "render.log").string() + ")");
     return report;
   }
@@ -274,10 +302,12 @@ Json PictureRenderer::finish() {
   if (settings_.video != "none" && report["pictures"].size() >= 2)
     make_video(dir_, settings_, report);
   report["camera"] = camera_json(p.camera);
+  if (!settings_.perspective)
+    report["strip_camera"] = camera_json(p.strip.camera);  // the one f3d used (strip_camera)
   report["scale"] = {{"scalar", settings_.scalar}, {"min", p.scale.min}, {"max", p.scale.max}};
   // f3d's wall time includes the plots drawn meanwhile (RunOutput::finish).
   report["timings"] = {{"panels", p.panels},
-                       {"f3d_renders", p.frames.size()},
+                       {"f3d_renders", jobs_count(p.frames, settings_.perspective)},
                        {"f3d_ms_per_panel", render_ms / double(p.panels)},
                        {"compose_ms", compose_ms},
                        {"video_ms", ms_since(t_video)},

@@ -9,6 +9,7 @@
 // Written into the run folder:
 //   pictures/step_STEP.png        the side-by-side picture of one frame
 //   pictures/panels/strip_STEP.png the frame's panels side by side as f3d rendered them
+//                                 (NAME_STEP.png, one per panel, with render.perspective)
 //   pictures/render.sh            the f3d script that made the panels (re-runnable by hand)
 //   run.gif or run.mp4            the pictures in turn (when there are 2 or more)
 // A missing tool (f3d, Xvfb, ffmpeg) is a warning, never a failed run.

@@ -41,6 +41,7 @@ RenderSettings read_render(Reader& root) {
   s.scalar = r.text("scalar", s.scalar, {"stretch", "gap"});
   s.video = r.text("video", s.video, {"gif", "mp4", "none"});
   s.range = r.number("range", s.range, 0, 10);
+  s.perspective = r.boolean("perspective", s.perspective);
   Reader cam = r.object("camera");
   s.camera = read_camera(cam);
   r.finish();

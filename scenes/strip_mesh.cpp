@@ -50,7 +50,8 @@ Polygon clip(const Polygon& in, const HalfSpace& h) {
 // two planes through the eye.
 std::array<HalfSpace, 2> column(const StripCamera& s, int k, int n, double aspect) {
   const Camera& c = s.camera;
-  const Eigen::Vector3d e = c.position, f = (c.target - e).normalized(), r = s.step.normalized();
+  const Eigen::Vector3d e = c.position, f = (c.target - e).normalized(),
+                        r = f.cross(c.up).normalized();
   const double tan_h = std::tan(0.5 * c.view_angle * std::numbers::pi / 180) * aspect * n;
   const double x0 = -1 + 2.0 * k / n, x1 = x0 + 2.0 / n;
   const Eigen::Vector3d left = r - x0 * tan_h * f, right = x1 * tan_h * f - r;
