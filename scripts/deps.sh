@@ -12,7 +12,7 @@ packages=(
   libcgal-dev  # optional: the cut's caps (constrained Delaunay) and the cut benchmark's CGAL clip
   slurmctld slurmd slurm-client munge  # sweep_slurm_test: a one-node Slurm cluster
   f3d xvfb xauth  # conform run's pictures: f3d renders them under a virtual X display (xvfb-run)
-  libcairo2-dev   # conform run's pictures: the panels put side by side with a colour bar
+  libcairo2-dev libpng-dev  # conform run's pictures: the panels side by side, a colour bar
   ffmpeg          # conform run's video of the pictures (run.gif / run.mp4)
   libtinygltf-dev # conform run's run.glb (glTF 2.0 binary)
   clang-14 libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer targets (CI's bounded fuzz run)
