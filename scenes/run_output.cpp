@@ -173,38 +173,59 @@ void write_axes(std::ostream& gp, const Plot& p) {
 
 }  // namespace
 
-bool draw_plot(const fs::path& dir, const Plot& plot, std::string& problem) {
+namespace {
+
+bool write_plot_script(const fs::path& dir, const Plot& plot, std::string& problem) {
   const fs::path script = dir / (plot.name + ".gp");
-  {
-    std::ofstream gp(script);
-    if (!gp) {
-      problem = "cannot write " + script.string();
-      return false;
-    }
-    const int panels = std::max<int>(1, static_cast<int>(plot.panels.size()));
-    gp << "# Drawn by conform from the CSV files beside it: gnuplot " << plot.name << ".gp\n"
-       << "set terminal pngcairo size " << (panels > 1 ? 600 * panels : 1000)
-       << ",600 enhanced font 'sans,11'\n"
-       << "set output " << quote(plot.name + ".png") << "\n"
-       << "set datafile separator ','\n"
-       << "set grid\nset key top left\n";
-    if (plot.panels.empty()) {
-      write_axes(gp, plot);
-    } else {
-      gp << "set multiplot layout 1," << panels << " title " << quote(plot.title) << "\n";
-      for (const auto& p : plot.panels) write_axes(gp, p);
-      gp << "unset multiplot\n";
-    }
-  }
-  const std::string cmd = "cd " + quote(dir.string()) + " && gnuplot " + quote(plot.name + ".gp") +
-                          " > " + quote(plot.name + ".log") + " 2>&1";
-  const int rc = std::system(cmd.c_str());
-  if (rc != 0) {
-    problem = "gnuplot failed (see " + plot.name + ".log in the output folder)";
+  std::ofstream gp(script);
+  if (!gp) {
+    problem = "cannot write " + script.string();
     return false;
   }
-  fs::remove(dir / (plot.name + ".log"));
-  return true;
+  const int panels = std::max<int>(1, static_cast<int>(plot.panels.size()));
+  // `reset` first: the scripts run one after the other in one gnuplot (draw_plots).
+  gp << "# Drawn by conform from the CSV files beside it: gnuplot " << plot.name << ".gp\n"
+     << "reset\nset terminal pngcairo size " << (panels > 1 ? 600 * panels : 1000)
+     << ",600 enhanced font 'sans,11'\n"
+     << "set output " << quote(plot.name + ".png") << "\n"
+     << "set datafile separator ','\n"
+     << "set grid\nset key top left\n";
+  if (plot.panels.empty()) {
+    write_axes(gp, plot);
+  } else {
+    gp << "set multiplot layout 1," << panels << " title " << quote(plot.title) << "\n";
+    for (const auto& p : plot.panels) write_axes(gp, p);
+    gp << "unset multiplot\n";
+  }
+  gp << "unset output\n";  // the PNG is complete before the next script starts
+  if (!gp) problem = "cannot write " + script.string();
+  return bool(gp);
+}
+
+}  // namespace
+
+std::vector<std::string> draw_plots(const fs::path& dir, const std::vector<Plot>& plots) {
+  std::vector<std::string> problems(plots.size());
+  std::string scripts;
+  for (std::size_t i = 0; i < plots.size(); ++i)
+    if (write_plot_script(dir, plots[i], problems[i]))
+      scripts += " " + quote(plots[i].name + ".gp");
+  if (scripts.empty()) return problems;
+  // One gnuplot for all: its start-up (fonts, cairo) is most of a small plot's cost.
+  const std::string cmd =
+      "cd " + quote(dir.string()) + " && gnuplot" + scripts + " > plots.log 2>&1";
+  const bool ok = std::system(cmd.c_str()) == 0;
+  // gnuplot stops at the first failing script: what came before it was drawn.
+  for (std::size_t i = 0; i < plots.size(); ++i)
+    if (problems[i].empty() && (!ok || !fs::exists(dir / (plots[i].name + ".png"))))
+      problems[i] = "gnuplot failed (see plots.log in the output folder)";
+  if (ok) fs::remove(dir / "plots.log");
+  return problems;
+}
+
+bool draw_plot(const fs::path& dir, const Plot& plot, std::string& problem) {
+  problem = draw_plots(dir, {plot}).front();
+  return problem.empty();
 }
 
 bool have_gnuplot() {
@@ -245,14 +266,12 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   Json plots = Json::object();
   const auto plots_start = Clock::now();
   if (common_.plots) {
-    const bool gnuplot = have_gnuplot();
-    for (const auto& p : plots_) {
-      std::string problem = "gnuplot is not installed (scripts/deps.sh installs gnuplot-nox)";
-      if (gnuplot && draw_plot(dir_, p, problem))
-        plots[p.name] = p.name + ".png";
-      else
-        plots[p.name] = "not drawn: " + problem;
-    }
+    std::vector<std::string> problems(
+        plots_.size(), "gnuplot is not installed (scripts/deps.sh installs gnuplot-nox)");
+    if (have_gnuplot()) problems = draw_plots(dir_, plots_);
+    for (std::size_t i = 0; i < plots_.size(); ++i)
+      plots[plots_[i].name] =
+          problems[i].empty() ? plots_[i].name + ".png" : "not drawn: " + problems[i];
   }
   const double plots_ms =
       std::chrono::duration<double, std::milli>(Clock::now() - plots_start).count();

@@ -137,6 +137,10 @@ class RunOutput {
 /// files are relative to `dir`. False with `problem` set when gnuplot failed or is missing.
 /// RunOutput and `conform sweep` draw through this one function.
 bool draw_plot(const std::filesystem::path& dir, const Plot& plot, std::string& problem);
+/// Draws every plot as draw_plot does, in one gnuplot process; returns each plot's problem
+/// ("" when drawn).
+std::vector<std::string> draw_plots(const std::filesystem::path& dir,
+                                    const std::vector<Plot>& plots);
 /// Whether gnuplot is on the PATH.
 bool have_gnuplot();
 
