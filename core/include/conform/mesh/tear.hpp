@@ -154,7 +154,8 @@ class Tear {
   std::int32_t first_new_vertex_ = 0;  // vertices from here on were added by this tear
   std::int32_t tip_neighbor_ = -1;     // a vertex sharing an edge with the tip
   Eigen::Vector3d tip_target_ = Eigen::Vector3d::Zero();  // the blade's hit the tip stands for
-  ScalpelSample previous_;  // the last sample seen: where the blade's sweep starts
+  bool tip_off_track_ = false;  // smooth_lips: the tip was moved off that hit, Π goes through it
+  ScalpelSample previous_;      // the last sample seen: where the blade's sweep starts
   int steps_ = 0;
   std::string message_;
 };
