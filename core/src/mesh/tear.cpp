@@ -432,17 +432,26 @@ class TearAdvance {
   void walk_from(const Move& m) {
     std::vector<Crossing> trial{{m.face, {PathPoint::Vertex, tear_.tip_}, m.out}};
     std::vector<std::int32_t> visited{m.face};
-    if (!within_sweep(trial.back())) return;
+    if (!within_sweep(trial.back()) || at_border_vertex(trial.back())) return;
     for (int guard = 0; guard < tear_.options_.max_walk_faces; ++guard) {
       const WalkStep next = trial.back().out.kind == PathPoint::Edge ? cross_edge(trial, visited)
                                                                      : pass_vertex(trial, visited);
       if (next == WalkStep::Failed) return;
       if (next == WalkStep::Moved && !within_sweep(trial.back())) return;  // left the sweep
+      if (next == WalkStep::Moved && at_border_vertex(trial.back())) return;
       if (next == WalkStep::Reached) {
         path_ = std::move(trial);
         return;
       }
     }
+  }
+
+  // With smooth_lips, a walk that reaches a vertex on a border (the tear's own lips, where a
+  // stroke turns about) stops there like one that meets a boundary: a path through it would
+  // pinch the border (two fans of faces on one vertex).
+  bool at_border_vertex(const Crossing& c) const {
+    return tear_.options_.smooth_lips && c.out.kind == PathPoint::Vertex &&
+           on_border(c.face, corner_of(c.face, c.out.v));
   }
 
   enum class WalkStep { Moved, Reached, Failed };
@@ -686,6 +695,13 @@ class TearAdvance {
     if (last.out.kind != PathPoint::Inside) return false;
     const std::int32_t face = last.face;
     const Face f = mesh_.faces[static_cast<std::size_t>(face)];
+    // A path that comes back beside the tear's own border (a stroke that turns about) is left to
+    // the crossing splits: a tip joined to that border would pinch it.
+    for (int k = 0; k < 3; ++k)
+      if (f[k] != tear_.tip_ && on_border(face, k)) return false;
+    for (const Crossing& c : path_)
+      if (c.out.kind == PathPoint::Vertex && on_border(c.face, corner_of(c.face, c.out.v)))
+        return false;
     std::array<double, 3> raw{};
     if (!segment_triangle(s_.a, s_.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
                           mesh_.current.col(f[2]), raw))
@@ -733,6 +749,21 @@ class TearAdvance {
     tip_id_ = tip;
     target_ = lambda > 0 ? pos(last.out, face) : position_of(tip);
     off_track_ = lambda > 0;
+    return true;
+  }
+
+  // Corner k of `face` is on a border of the mesh (the tear's slit or a boundary): a face
+  // around it has an edge without a twin.
+  bool on_border(std::int32_t face, int k) const {
+    const std::int32_t h0 = 3 * face + k;  // out of the corner
+    std::int32_t h = h0;
+    for (int guard = 0; guard < 4096; ++guard) {
+      const std::int32_t prev = 3 * (h / 3) + (h % 3 + 2) % 3;  // into the corner
+      const std::int32_t o = adjacency_.twin(prev);
+      if (o < 0 || adjacency_.twin(h) < 0) return true;
+      if (o == h0) return false;
+      h = o;
+    }
     return true;
   }
 
