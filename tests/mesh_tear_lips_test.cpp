@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <numbers>
+#include <random>
 #include <set>
 
 #include "conform/io/import.hpp"
@@ -181,4 +182,60 @@ TEST(TearLips, OnARealModel) {
   }
   EXPECT_GE(measured, 4);
   EXPECT_LT(turning, 0.6 * turning_before);
+}
+
+TEST(TearLips, RandomStrokesKeepAManifoldSurface) {
+  // 200 strokes on the arm, each 30 samples along it with the blade turning and wiggling about
+  // the limb's axis: with smooth_lips every torn mesh stays manifold and oriented, of the same
+  // area, and every face on a vertex the tear added keeps min(5°, half the input's smallest
+  // angle, 4.6°). Measured: none pinched (3 of the first 300 did before the corner snap left the
+  // ends of the edge the path came in by alone), smallest such angle 4.6° in an input face of
+  // 4.6° (2.5° without smooth_lips); the samples extend the tear 2 % more often (5761 / 5648).
+  const SkinnedMesh in = make_arm(1).mesh;
+  double input = 180;
+  for (const Face& f : in.faces)
+    input = std::min(
+        input, smallest_angle(in.current.col(f[0]), in.current.col(f[1]), in.current.col(f[2])));
+  const double bound = std::min(kTearMinAngle, input / 2);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int extended = 0, extended_default = 0;
+  double smallest[2] = {180, 180};  // without, with smooth_lips
+  for (int run = 0; run < 200; ++run) {
+    const double z0 = 0.30 + 0.1 * (u(rng) + 1), dz = 0.002 + 0.002 * (u(rng) + 1);
+    const double a0 = 3.1 * u(rng), da = 0.03 * u(rng), wiggle = 0.02 * u(rng);
+    std::vector<ScalpelSample> samples;
+    for (int i = 0; i < 30; ++i) {
+      const double angle = a0 + da * i + wiggle * std::sin(0.7 * i), z = z0 + dz * i;
+      const Eigen::Vector3d out(std::cos(angle), std::sin(angle), 0);
+      samples.push_back({double(i), 0.09 * out + Eigen::Vector3d(0, 0, z),
+                         0.005 * out + Eigen::Vector3d(0, 0, z)});
+    }
+    for (const bool smooth : {true, false}) {
+      SkinnedMesh m = in;
+      Adjacency adj(m);
+      TearOptions options;
+      options.smooth_lips = smooth;
+      Tear tear(m, adj, options);
+      int& count = smooth ? extended : extended_default;
+      for (const auto& s : samples) count += tear.advance(s).extended;
+      for (const Face& f : m.faces)
+        if (*std::max_element(f.begin(), f.end()) >= in.vertex_count())
+          smallest[smooth] = std::min(
+              smallest[smooth],
+              smallest_angle(m.current.col(f[0]), m.current.col(f[1]), m.current.col(f[2])));
+      if (!smooth) continue;
+      const MeshReport report = check_mesh(m);
+      ASSERT_TRUE(report.manifold() && report.oriented() && report.indices_valid)
+          << run << ": " << report.summary();
+      EXPECT_NEAR(surface_area(m), surface_area(in), 1e-3 * surface_area(in)) << run;
+      ASSERT_GE(smallest[true], bound - 1e-9) << run;
+    }
+  }
+  const double deg = 180 / std::numbers::pi;
+  std::printf(
+      "random strokes: %d samples extend the tear, smallest angle of a face on a new vertex "
+      "%.2f deg (without smooth_lips: %d, %.2f deg)\n",
+      extended, smallest[true] * deg, extended_default, smallest[false] * deg);
+  EXPECT_GE(extended, extended_default);
 }

@@ -810,9 +810,12 @@ class TearAdvance {
     double nearest = kLipSnapReach * edge;
     for (int k = 0; k < 3; ++k) {
       const double d = (mesh_.current.col(f[k]) - hit).norm();
-      if (d < nearest && std::abs(delta(f[k])) <= kLipSnap * edge &&
-          !(last.in.kind == PathPoint::Vertex && last.in.v == f[k]))
-        nearest = d, best = k;
+      // Not the corner the path came in by, nor an end of the edge it came in through (the
+      // chord would run along that edge).
+      const bool behind =
+          (last.in.kind == PathPoint::Vertex && last.in.v == f[k]) ||
+          (last.in.kind == PathPoint::Edge && (last.in.a == f[k] || last.in.b == f[k]));
+      if (d < nearest && std::abs(delta(f[k])) <= kLipSnap * edge && !behind) nearest = d, best = k;
     }
     if (best < 0) return false;
     std::vector<Crossing> path = path_;
