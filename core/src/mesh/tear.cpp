@@ -709,9 +709,10 @@ class TearAdvance {
     for (auto& x : raw) x = std::max(x, kExactMargin);
     const double sum = raw[0] + raw[1] + raw[2];
     for (auto& x : raw) x /= sum;
+    const Eigen::Vector3d pa = mesh_.current.col(f[0]), pb = mesh_.current.col(f[1]),
+                          pc = mesh_.current.col(f[2]);
+    const Eigen::Vector3d hit = raw[0] * pa + raw[1] * pb + raw[2] * pc;
     if (lambda > 0) {  // toward the incenter
-      const Eigen::Vector3d pa = mesh_.current.col(f[0]), pb = mesh_.current.col(f[1]),
-                            pc = mesh_.current.col(f[2]);
       const double la = (pc - pb).norm(), lb = (pa - pc).norm(), lc = (pb - pa).norm();
       const double p = la + lb + lc;
       const std::array<double, 3> in{la / p, lb / p, lc / p};
@@ -747,7 +748,7 @@ class TearAdvance {
       if (smallest_angle_sin2(position_of(g[0]), position_of(g[1]), position_of(g[2])) < floor2)
         return false;
     tip_id_ = tip;
-    target_ = lambda > 0 ? pos(last.out, face) : position_of(tip);
+    target_ = hit;
     off_track_ = lambda > 0;
     return true;
   }
