@@ -125,9 +125,12 @@ TEST(TearLips, OnARealModel) {
   // 1.56 / 1.56, 0.002 / 0.074, 0.016 / 0.057, 0.015 / 0.012, 0.016 / 0.057 edges. The first
   // stroke leaves the surface: the blade, straight in its start face's plane, meets this coarse
   // model 2.4 edges past the tip at one sample, and the walk there goes around the model's
-  // side (1.6 edges off the swept surface, with or without smooth_lips) and back, where the
-  // path turns about. Issue 18's bounds hold on the four strokes the default tear follows
-  // (within an edge of the swept surface).
+  // side (1.6 edges off the swept surface, with or without smooth_lips) to the far branch of the
+  // blade plane's section, along which the path turns about (167° at that point, a real
+  // reversal of the track, not a fold of the surface); with smooth_lips the tear then stops where
+  // the walk comes back beside its own lips (6 of 24 samples extend it, 7 before). Issue 18's
+  // bounds hold on the four strokes the default tear follows (within an edge of the swept
+  // surface).
   const auto path = std::filesystem::path(CONFORM_ASSIMP_MODELS) / "FBX/huesitos.fbx";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "assimp-testmodels not installed";
   const SkinnedMesh in = io::load_model(path.string()).mesh;
