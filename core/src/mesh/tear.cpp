@@ -1146,22 +1146,36 @@ bool Tear::start(const ScalpelSample& s, TearStep& step) {
   const double sum = bary[0] + bary[1] + bary[2];
   for (auto& x : bary) x /= sum;
   const Face f = mesh_.faces[static_cast<std::size_t>(hit)];
-  {
-    const Eigen::Vector3d a = mesh_.current.col(f[0]), b = mesh_.current.col(f[1]),
-                          c = mesh_.current.col(f[2]);
-    tip_target_ = bary[0] * a + bary[1] * b + bary[2] * c;
-    bary = place_tip(bary, a, b, c, {a, b, c}, options_.min_angle);
-  }
-  TopologyChange ch;
-  ch.base_vertex_count = mesh_.vertex_count();
-  ch.base_face_count = mesh_.face_count();
+  const Eigen::Vector3d a = mesh_.current.col(f[0]), b = mesh_.current.col(f[1]),
+                        c = mesh_.current.col(f[2]);
+  tip_target_ = bary[0] * a + bary[1] * b + bary[2] * c;
   const std::int32_t s0 = mesh_.vertex_count();
-  ch.new_vertices.push_back(NewVertex::in_face(f[0], f[1], f[2], bary[0], bary[1], bary[2]));
-  ch.removed_faces = {hit};
-  ch.added_faces = {{f[0], f[1], s0}, {f[1], f[2], s0}, {f[2], f[0], s0}};
+  auto fan_change = [&](const std::array<double, 3>& w) {
+    TopologyChange ch;
+    ch.base_vertex_count = mesh_.vertex_count();
+    ch.base_face_count = mesh_.face_count();
+    ch.new_vertices.push_back(NewVertex::in_face(f[0], f[1], f[2], w[0], w[1], w[2]));
+    ch.removed_faces = {hit};
+    ch.added_faces = {{f[0], f[1], s0}, {f[1], f[2], s0}, {f[2], f[0], s0}};
+    return ch;
+  };
+  // smooth_lips: the start at the hit, the slivers of its fan flipped away (change_flips.hpp);
+  // else (or where flips leave a face below the floor) moved toward the face's incenter.
+  TopologyChange ch = fan_change(bary);
+  bool exact = options_.smooth_lips;
+  if (exact) {
+    flip_for_angles(mesh_, adjacency_, ch, {});
+    auto at = [&](std::int32_t v) {
+      return v == s0 ? tip_target_ : Eigen::Vector3d(mesh_.current.col(v));
+    };
+    const double floor2 = std::pow(std::sin(options_.min_angle), 2);
+    for (const Face& g : ch.added_faces)
+      exact = exact && smallest_angle_sin2(at(g[0]), at(g[1]), at(g[2])) >= floor2;
+  }
+  if (!exact) ch = fan_change(place_tip(bary, a, b, c, {a, b, c}, options_.min_angle));
   commit(std::move(ch), step);
   tip_ = s0;
-  tip_off_track_ = options_.smooth_lips;
+  tip_off_track_ = options_.smooth_lips && !exact;
   tip_neighbor_ = f[0];
   path_.push_back({s0, -1, Eigen::Vector3d::Zero()});
   message_.clear();
