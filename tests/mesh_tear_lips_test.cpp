@@ -120,9 +120,9 @@ TEST(TearLips, OnTheArm) {
 TEST(TearLips, OnARealModel) {
   // huesitos.fbx (welded, 62 vertices): strokes along its longest extent from faces spread
   // over it, as in mesh_real_models_test, with and without smooth_lips; the first five that
-  // extend at least six times. Measured: lip turning 167 / 180, 10.7 / 87, 4.7 / 56,
+  // extend at least six times. Measured: lip turning 167 / 180, 10.6 / 87, 4.7 / 56,
   // 5.8 / 15, 4.6 / 56 degrees (smooth_lips / before), border to the swept surface
-  // 1.56 / 1.56, 0.002 / 0.074, 0.016 / 0.057, 0.015 / 0.012, 0.016 / 0.057 edges. The first
+  // 1.56 / 1.56, 0.000 / 0.074, 0.016 / 0.057, 0.015 / 0.012, 0.016 / 0.057 edges. The first
   // stroke leaves the surface: the blade, straight in its start face's plane, meets this coarse
   // model 2.4 edges past the tip at one sample, and the walk there goes around the model's
   // side (1.6 edges off the swept surface, with or without smooth_lips) to the far branch of the
