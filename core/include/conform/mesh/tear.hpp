@@ -25,6 +25,7 @@
 //     Then edges beside the path are flipped while that raises the smallest angle of their two
 //     faces (the path's edges kept, quads flat and convex, corner-attribute seams kept). Every
 //     face the step adds or flips then has smallest angle ≥ min_angle, or the next case is tried.
+//     The start S_0 too is put at its hit with its fan flipped, where that keeps the floor.
 //   - Else, in order: the tip on the path's last edge crossing when the hit is within
 //     kLipBehind = 0.4 edge past it (past a vertex the walk reached, on that vertex); on a corner
 //     of the hit's face within 0.3 edge of the hit and 0.05 edge of Π; on the nearer of the edge
