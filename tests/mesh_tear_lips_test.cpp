@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <numbers>
+#include <random>
+#include <set>
 
 #include "conform/io/import.hpp"
 #include "conform/mesh/analysis.hpp"
@@ -34,13 +36,45 @@ ScalpelSample arm_sample(Stroke kind, int i, int n) {
           0.005 * out + y * side + Eigen::Vector3d(0, 0, z)};
 }
 
+// The smallest angle (degrees) of the faces the tear added (or flipped), and of the input.
+struct Floor {
+  double added = 180, input = 180;
+};
+
 test::LipQuality tear_and_measure(const SkinnedMesh& in, const std::vector<ScalpelSample>& samples,
-                                  double amount, const TearOptions& options, int& extended) {
+                                  double amount, const TearOptions& options, int& extended,
+                                  Floor* floor = nullptr) {
   SkinnedMesh m = in;
   Adjacency adj(m);
   Tear tear(m, adj, options);
   extended = 0;
   for (const auto& s : samples) extended += tear.advance(s).extended;
+  // The torn mesh is still a manifold, oriented surface of the same area: splits keep it
+  // exactly, flips (smooth_lips) only across nearly flat quads.
+  const MeshReport report = check_mesh(m);
+  EXPECT_TRUE(report.manifold() && report.oriented() && report.indices_valid)
+      << report.summary() << (options.smooth_lips ? " (smooth lips)" : "");
+  EXPECT_NEAR(surface_area(m), surface_area(in), 1e-3 * surface_area(in));
+  if (floor) {
+    std::set<Face> old;
+    auto key = [](Face f) {
+      std::rotate(f.begin(), std::min_element(f.begin(), f.end()), f.end());
+      return f;
+    };
+    for (const Face& f : in.faces) {
+      old.insert(key(f));
+      floor->input = std::min(
+          floor->input,
+          smallest_angle(in.current.col(f[0]), in.current.col(f[1]), in.current.col(f[2])) * 180 /
+              std::numbers::pi);
+    }
+    for (const Face& f : m.faces)
+      if (!old.count(key(f)))
+        floor->added =
+            std::min(floor->added,
+                     smallest_angle(m.current.col(f[0]), m.current.col(f[1]), m.current.col(f[2])) *
+                         180 / std::numbers::pi);
+  }
   return test::lip_quality(in, m, tear, samples, amount);
 }
 
@@ -52,11 +86,12 @@ void report(const char* what, const test::LipQuality& q, int extended) {
 }  // namespace
 
 TEST(TearLips, OnTheArm) {
-  // Measured (smooth_lips / before): border to the blade's swept surface 0.020 / 0.094,
-  // 0.109 / 0.230, 0.099 / 0.131 local edges; lip turning after opening 5.3 / 136, 31.7 / 166,
-  // 41.9 / 164 degrees; thin faces on one vertex 2 / 3, 3 / 5, 4 / 5 (straight, curved,
-  // oblique). Issue 18's bounds (0.1 edge, 30°) hold on the straight stroke; the curved one is
-  // just outside both, the oblique one outside the turning bound.
+  // Measured (smooth_lips / before): border to the blade's swept surface 0.000 / 0.094,
+  // 0.028 / 0.230, 0.012 / 0.131 local edges; lip turning after opening 0.7 / 136, 10.0 / 166,
+  // 3.7 / 164 degrees; longest over shortest path segment 1.01 / 6.75, 1.36 / 8.37,
+  // 1.05 / 13.4; thin faces on one vertex 0 / 3, 2 / 5, 3 / 5 (straight, curved, oblique).
+  // Issue 18's bounds (0.1 edge, 30°) hold on all three; every face the tear adds or flips keeps
+  // the sliver floor (5°).
   const SkinnedMesh in = make_arm(1).mesh;
   const char* names[] = {"straight", "curved", "oblique"};
   for (const Stroke kind : {Stroke::straight, Stroke::curved, Stroke::oblique}) {
@@ -65,34 +100,37 @@ TEST(TearLips, OnTheArm) {
     TearOptions before, smooth;
     smooth.smooth_lips = true;
     int extended = 0, extended_before = 0;
-    const test::LipQuality q = tear_and_measure(in, samples, 0.01, smooth, extended);
+    Floor floor;
+    const test::LipQuality q = tear_and_measure(in, samples, 0.01, smooth, extended, &floor);
     const test::LipQuality b = tear_and_measure(in, samples, 0.01, before, extended_before);
     report(names[int(kind)], q, extended);
     report("  before", b, extended_before);
     const char* what = names[int(kind)];
     EXPECT_GE(extended, extended_before) << what;  // the tip still follows the blade
-    EXPECT_LE(q.track_distance, b.track_distance + 1e-9) << what;
-    EXPECT_LE(q.fan, b.fan) << what;
     EXPECT_LT(q.fan, b.fan) << what;
+    EXPECT_LE(q.track_distance, b.track_distance + 1e-9) << what;
     EXPECT_LT(q.turning_deg, 0.3 * b.turning_deg) << what;
-    if (kind == Stroke::curved) {
-      EXPECT_LT(q.track_distance, 0.5 * b.track_distance);
-    } else {
-      EXPECT_LT(q.track_distance, 0.1) << what;  // issue 18's bound
-    }
-    if (kind == Stroke::straight) {
-      EXPECT_LT(q.turning_deg, 30);  // and its other one
-    }
+    EXPECT_LT(q.track_distance, 0.1) << what;  // issue 18's bounds
+    EXPECT_LT(q.turning_deg, 30) << what;
+    EXPECT_LT(q.spacing_ratio, 2) << what;  // one path point per sample, evenly spaced
+    EXPECT_GE(floor.added, kTearMinAngle * 180 / std::numbers::pi - 1e-9) << what;
   }
 }
 
 TEST(TearLips, OnARealModel) {
   // huesitos.fbx (welded, 62 vertices): strokes along its longest extent from faces spread
   // over it, as in mesh_real_models_test, with and without smooth_lips; the first five that
-  // extend at least six times. Measured: lip turning 160 / 180, 20 / 87, 11 / 56,
-  // 2.6 / 15, 11 / 56 degrees (smooth_lips / before); the first goes 1.6 edges off the swept
-  // surface either way, and there the tip waits for the blade once more (6 of 24 samples
-  // extend, 7 before).
+  // extend at least six times. Measured: lip turning 167 / 180, 10.6 / 87, 4.7 / 56,
+  // 5.8 / 15, 4.6 / 56 degrees (smooth_lips / before), border to the swept surface
+  // 1.56 / 1.56, 0.000 / 0.074, 0.016 / 0.057, 0.015 / 0.012, 0.016 / 0.057 edges. The first
+  // stroke leaves the surface: the blade, straight in its start face's plane, meets this coarse
+  // model 2.4 edges past the tip at one sample, and the walk there goes around the model's
+  // side (1.6 edges off the swept surface, with or without smooth_lips) to the far branch of the
+  // blade plane's section, along which the path turns about (167° at that point, a real
+  // reversal of the track, not a fold of the surface); with smooth_lips the tear then stops where
+  // the walk comes back beside its own lips (6 of 24 samples extend it, 7 before). Issue 18's
+  // bounds hold on the four strokes the default tear follows (within an edge of the swept
+  // surface).
   const auto path = std::filesystem::path(CONFORM_ASSIMP_MODELS) / "FBX/huesitos.fbx";
   if (!std::filesystem::exists(path)) GTEST_SKIP() << "assimp-testmodels not installed";
   const SkinnedMesh in = io::load_model(path.string()).mesh;
@@ -126,7 +164,8 @@ TEST(TearLips, OnARealModel) {
     TearOptions before, smooth;
     smooth.smooth_lips = true;
     int extended = 0, extended_before = 0;
-    const test::LipQuality q = tear_and_measure(in, samples, 0.2 * edge, smooth, extended);
+    Floor floor;
+    const test::LipQuality q = tear_and_measure(in, samples, 0.2 * edge, smooth, extended, &floor);
     const test::LipQuality o = tear_and_measure(in, samples, 0.2 * edge, before, extended_before);
     if (extended_before < 6) continue;
     ++measured;
@@ -135,8 +174,71 @@ TEST(TearLips, OnARealModel) {
     EXPECT_GE(extended, extended_before - 1) << f;
     EXPECT_LE(q.track_distance, 1.01 * std::max(o.track_distance, 0.1)) << f;
     EXPECT_LE(q.fan, o.fan) << f;
+    std::printf("  added faces' smallest angle %.2f deg (input %.2f)\n", floor.added, floor.input);
+    EXPECT_GE(floor.added,
+              std::min(kTearMinAngle * 180 / std::numbers::pi, floor.input / 2) - 1e-9);
+    if (o.track_distance < 1) {
+      EXPECT_LT(q.track_distance, 0.1) << f;
+      EXPECT_LT(q.turning_deg, 30) << f;
+    }
     turning += q.turning_deg, turning_before += o.turning_deg;
   }
   EXPECT_GE(measured, 4);
   EXPECT_LT(turning, 0.6 * turning_before);
+}
+
+TEST(TearLips, RandomStrokesKeepAManifoldSurface) {
+  // 200 strokes on the arm, each 30 samples along it with the blade turning and wiggling about
+  // the limb's axis: with smooth_lips every torn mesh stays manifold and oriented, of the same
+  // area, and every face on a vertex the tear added keeps min(5°, half the input's smallest
+  // angle, 4.6°). Measured: none pinched (3 of the first 300 did before the corner snap left the
+  // ends of the edge the path came in by alone), smallest such angle 4.6° in an input face of
+  // 4.6° (2.5° without smooth_lips); the samples extend the tear 2 % more often (5761 / 5648).
+  const SkinnedMesh in = make_arm(1).mesh;
+  double input = 180;
+  for (const Face& f : in.faces)
+    input = std::min(
+        input, smallest_angle(in.current.col(f[0]), in.current.col(f[1]), in.current.col(f[2])));
+  const double bound = std::min(kTearMinAngle, input / 2);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int extended = 0, extended_default = 0;
+  double smallest[2] = {180, 180};  // without, with smooth_lips
+  for (int run = 0; run < 200; ++run) {
+    const double z0 = 0.30 + 0.1 * (u(rng) + 1), dz = 0.002 + 0.002 * (u(rng) + 1);
+    const double a0 = 3.1 * u(rng), da = 0.03 * u(rng), wiggle = 0.02 * u(rng);
+    std::vector<ScalpelSample> samples;
+    for (int i = 0; i < 30; ++i) {
+      const double angle = a0 + da * i + wiggle * std::sin(0.7 * i), z = z0 + dz * i;
+      const Eigen::Vector3d out(std::cos(angle), std::sin(angle), 0);
+      samples.push_back({double(i), 0.09 * out + Eigen::Vector3d(0, 0, z),
+                         0.005 * out + Eigen::Vector3d(0, 0, z)});
+    }
+    for (const bool smooth : {true, false}) {
+      SkinnedMesh m = in;
+      Adjacency adj(m);
+      TearOptions options;
+      options.smooth_lips = smooth;
+      Tear tear(m, adj, options);
+      int& count = smooth ? extended : extended_default;
+      for (const auto& s : samples) count += tear.advance(s).extended;
+      for (const Face& f : m.faces)
+        if (*std::max_element(f.begin(), f.end()) >= in.vertex_count())
+          smallest[smooth] = std::min(
+              smallest[smooth],
+              smallest_angle(m.current.col(f[0]), m.current.col(f[1]), m.current.col(f[2])));
+      if (!smooth) continue;
+      const MeshReport report = check_mesh(m);
+      ASSERT_TRUE(report.manifold() && report.oriented() && report.indices_valid)
+          << run << ": " << report.summary();
+      EXPECT_NEAR(surface_area(m), surface_area(in), 1e-3 * surface_area(in)) << run;
+      ASSERT_GE(smallest[true], bound - 1e-9) << run;
+    }
+  }
+  const double deg = 180 / std::numbers::pi;
+  std::printf(
+      "random strokes: %d samples extend the tear, smallest angle of a face on a new vertex "
+      "%.2f deg (without smooth_lips: %d, %.2f deg)\n",
+      extended, smallest[true] * deg, extended_default, smallest[false] * deg);
+  EXPECT_GE(extended, extended_default);
 }

@@ -9,6 +9,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "change_flips.hpp"
 #include "conform/cga/plane.hpp"
 #include "conform/mesh/analysis.hpp"
 #include "quad_split.hpp"
@@ -239,7 +240,10 @@ class TearAdvance {
   // the blade's point nearest the tip).
   bool make_plane() {
     tip_ = mesh_.current.col(tear_.tip_);
-    const auto plane = cga::Plane<double>::through(tip_, s_.a, s_.b);
+    // A tip moved off the blade's track (its fan) leaves Π on the track: through the hit it
+    // stands for, so that the path's next points do not take on its offset.
+    const Eigen::Vector3d from = tear_.tip_off_track_ ? tear_.tip_target_ : tip_;
+    const auto plane = cga::Plane<double>::through(from, s_.a, s_.b);
     if (!plane) {
       tear_.message_ = "the blade is collinear with the tip: no plane";
       return false;
@@ -428,17 +432,26 @@ class TearAdvance {
   void walk_from(const Move& m) {
     std::vector<Crossing> trial{{m.face, {PathPoint::Vertex, tear_.tip_}, m.out}};
     std::vector<std::int32_t> visited{m.face};
-    if (!within_sweep(trial.back())) return;
+    if (!within_sweep(trial.back()) || at_border_vertex(trial.back())) return;
     for (int guard = 0; guard < tear_.options_.max_walk_faces; ++guard) {
       const WalkStep next = trial.back().out.kind == PathPoint::Edge ? cross_edge(trial, visited)
                                                                      : pass_vertex(trial, visited);
       if (next == WalkStep::Failed) return;
       if (next == WalkStep::Moved && !within_sweep(trial.back())) return;  // left the sweep
+      if (next == WalkStep::Moved && at_border_vertex(trial.back())) return;
       if (next == WalkStep::Reached) {
         path_ = std::move(trial);
         return;
       }
     }
+  }
+
+  // With smooth_lips, a walk that reaches a vertex on a border (the tear's own lips, where a
+  // stroke turns about) stops there like one that meets a boundary: a path through it would
+  // pinch the border (two fans of faces on one vertex).
+  bool at_border_vertex(const Crossing& c) const {
+    return tear_.options_.smooth_lips && c.out.kind == PathPoint::Vertex &&
+           on_border(c.face, corner_of(c.face, c.out.v));
   }
 
   enum class WalkStep { Moved, Reached, Failed };
@@ -544,8 +557,8 @@ class TearAdvance {
     split_.base_face_count = mesh_.face_count();
     const bool smooth = tear_.options_.smooth_lips;
     const PathPoint blade = path_.back().out;
-    if (!(smooth && (split_with_tip_on_edge(kLipBehind) ||
-                     (tip_shift(path_.back()) > kLipShift && split_with_nearer_crossing())))) {
+    if (!(smooth && split_on_track())) {
+      off_track_ = smooth;
       restart_split();
       points_.push_back(tear_.tip_);
       for (std::size_t i = 0; i < path_.size(); ++i) {
@@ -555,6 +568,7 @@ class TearAdvance {
           // far, or else on the one ahead, where that makes no sliver.
           const std::string message = tear_.message_;
           path_.back().out = blade;
+          off_track_ = false;
           if (smooth && split_with_tip_on_edge(std::numeric_limits<double>::infinity(), true))
             break;
           tear_.message_ = message;
@@ -563,12 +577,30 @@ class TearAdvance {
         split_face(c);
       }
     }
+    if (smooth) flip_beside_path();
     std::sort(split_.removed_faces.begin(), split_.removed_faces.end());
     split_.removed_faces.erase(
         std::unique(split_.removed_faces.begin(), split_.removed_faces.end()),
         split_.removed_faces.end());
     tear_.commit(std::move(split_), step_);
     return true;
+  }
+
+  // The lips (TearOptions::smooth_lips): the first of these splits that keeps the new tip on the
+  // blade's track and every face it makes at or above min_angle. Else the tip is moved off the
+  // track toward its face's middle (place_new_tip) and the next step's Π passes through the hit.
+  bool split_on_track() {
+    return split_with_recovered_edges() || split_with_recovered_edges(true) ||
+           split_with_tip_on_edge(kLipBehind) || split_with_tip_on_corner() ||
+           split_with_nearer_crossing() || split_with_recovered_shifted();
+  }
+  // The recovered tip moved toward its face's incenter by the first of a few steps that keeps
+  // the floor: off the track by less than place_tip's tip (whose step is coarser and whose faces
+  // are not flipped); the next step's Π goes through the hit.
+  bool split_with_recovered_shifted() {
+    for (const double lambda : {0.1, 0.2, 0.35, 0.5})
+      if (split_with_recovered_edges(false, lambda)) return true;
+    return false;
   }
 
   void restart_split() {
@@ -652,13 +684,167 @@ class TearAdvance {
     return true;
   }
 
-  // Where an inside tip at the blade's hit would have to move more than kLipShift of its face's
-  // mean edge toward the face's middle to keep its fan above the floor (place_tip), off the
-  // blade's track, the tip goes on the nearer of the edge crossings behind and ahead of the hit,
-  // within kLipReach of that edge: an edge crossing lies on Π, so on the track. (Every shift is
-  // taken instead at 0.03 or 0.05: the lips turn less on the arm, but the tip waits for the
-  // blade more often on huesitos.fbx.)
-  static constexpr double kLipReach = 0.6, kLipShift = 0.1;
+  // The lips evenly spaced on the blade's track (TearOptions::smooth_lips): the new tip exactly
+  // at the blade's hit, joined to the old tip (through the vertices the walk went through) by
+  // edges that flips make (change_flips.hpp) instead of a chain of edge crossings, which would
+  // be moved off the track where they come near a vertex, to keep the sliver floor. Then flips
+  // for the smallest angle, the path's edges kept. False (nothing kept) where an edge cannot be
+  // made or a face would be thinner than min_angle.
+  bool split_with_recovered_edges(bool on_edge = false, double lambda = 0) {
+    Crossing& last = path_.back();
+    if (last.out.kind != PathPoint::Inside) return false;
+    const std::int32_t face = last.face;
+    const Face f = mesh_.faces[static_cast<std::size_t>(face)];
+    // A path that comes back beside the tear's own border (a stroke that turns about) is left to
+    // the crossing splits: a tip joined to that border would pinch it.
+    for (int k = 0; k < 3; ++k)
+      if (f[k] != tear_.tip_ && on_border(face, k)) return false;
+    for (const Crossing& c : path_)
+      if (c.out.kind == PathPoint::Vertex && on_border(c.face, corner_of(c.face, c.out.v)))
+        return false;
+    std::array<double, 3> raw{};
+    if (!segment_triangle(s_.a, s_.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
+                          mesh_.current.col(f[2]), raw))
+      return false;
+    for (auto& x : raw) x = std::max(x, kExactMargin);
+    const double sum = raw[0] + raw[1] + raw[2];
+    for (auto& x : raw) x /= sum;
+    const Eigen::Vector3d pa = mesh_.current.col(f[0]), pb = mesh_.current.col(f[1]),
+                          pc = mesh_.current.col(f[2]);
+    const Eigen::Vector3d hit = raw[0] * pa + raw[1] * pb + raw[2] * pc;
+    if (lambda > 0) {  // toward the incenter
+      const double la = (pc - pb).norm(), lb = (pa - pc).norm(), lc = (pb - pa).norm();
+      const double p = la + lb + lc;
+      const std::array<double, 3> in{la / p, lb / p, lc / p};
+      for (int k = 0; k < 3; ++k) raw[k] = (1 - lambda) * raw[k] + lambda * in[k];
+    }
+    restart_split();
+    std::vector<std::int32_t> slots;
+    points_.push_back(tear_.tip_);
+    for (const Crossing& c : path_) {
+      slots.push_back(c.face);
+      if (c.out.kind == PathPoint::Vertex) points_.push_back(c.out.v);
+    }
+    const std::int32_t tip = nv0_;
+    if (on_edge) {
+      if (!insert_tip_on_edge(face, raw)) return false;
+    } else {
+      split_.new_vertices.push_back(NewVertex::in_face(f[0], f[1], f[2], raw[0], raw[1], raw[2]));
+      split_.removed_faces.push_back(face);
+      for (int k = 0; k < 3; ++k) split_.added_faces.push_back({f[k], f[(k + 1) % 3], tip});
+    }
+    points_.push_back(tip);
+    const Eigen::Vector3d blade = s_.b - s_.a;
+    for (std::size_t i = 0; i + 1 < points_.size(); ++i) {
+      const Eigen::Vector3d n =
+          (position_of(points_[i + 1]) - position_of(points_[i])).cross(blade).normalized();
+      if (!n.allFinite() ||
+          !flip_to_edge(mesh_, adjacency_, split_, points_[i], points_[i + 1], n, slots))
+        return false;
+    }
+    flip_beside_path();
+    const double floor2 = std::pow(std::sin(tear_.options_.min_angle), 2);
+    for (const Face& g : split_.added_faces)
+      if (smallest_angle_sin2(position_of(g[0]), position_of(g[1]), position_of(g[2])) < floor2)
+        return false;
+    tip_id_ = tip;
+    target_ = hit;
+    off_track_ = lambda > 0;
+    return true;
+  }
+
+  // Corner k of `face` is on a border of the mesh (the tear's slit or a boundary): a face
+  // around it has an edge without a twin.
+  bool on_border(std::int32_t face, int k) const {
+    const std::int32_t h0 = 3 * face + k;  // out of the corner
+    std::int32_t h = h0;
+    for (int guard = 0; guard < 4096; ++guard) {
+      const std::int32_t prev = 3 * (h / 3) + (h % 3 + 2) % 3;  // into the corner
+      const std::int32_t o = adjacency_.twin(prev);
+      if (o < 0 || adjacency_.twin(h) < 0) return true;
+      if (o == h0) return false;
+      h = o;
+    }
+    return true;
+  }
+
+  // A blade hit within kEdgeTip (barycentric) of an edge of its face, where a tip inside the
+  // face would make a sliver that no flip removes (the edge on a fold of the surface): the tip on
+  // that edge, at the hit's projection, both faces of the edge split from their third vertex.
+  static constexpr double kEdgeTip = 0.05;
+  bool insert_tip_on_edge(std::int32_t face, const std::array<double, 3>& bary) {
+    const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
+    const int k = static_cast<int>(std::min_element(bary.begin(), bary.end()) - bary.begin());
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    if (!(bary[k] < kEdgeTip)) return false;
+    const double t = bary[j] / (bary[i] + bary[j]);
+    const std::int32_t x = f[i], y = f[j], z = f[k], tip = nv0_;
+    if (t < snap_ || t > 1 - snap_) return false;  // at a vertex: the corner snap's
+    split_.new_vertices.push_back(NewVertex::on_edge(x, y, t));
+    split_.removed_faces.push_back(face);
+    split_.added_faces.push_back({z, x, tip});
+    split_.added_faces.push_back({z, tip, y});
+    const std::int32_t h = adjacency_.find(y, x);
+    if (h < 0) return true;  // a border edge
+    const std::int32_t w = mesh_.faces[static_cast<std::size_t>(h / 3)][(h % 3 + 2) % 3];
+    split_.removed_faces.push_back(h / 3);
+    split_.added_faces.push_back({w, y, tip});
+    split_.added_faces.push_back({w, tip, x});
+    return true;
+  }
+
+  // The recovered tip's least barycentric coordinate in its face.
+  static constexpr double kExactMargin = 0.01;
+
+  // A blade hit within kLipSnapReach of its face's mean edge from a corner of the face that
+  // lies within kLipSnap of Π (on the blade's track) puts the tip on that corner, where a tip at
+  // the hit would make a sliver with it: the face is split along the chord from the path's last
+  // crossing to it.
+  static constexpr double kLipSnap = 0.05, kLipSnapReach = 0.3;
+  bool split_with_tip_on_corner() {
+    const Crossing& last = path_.back();
+    if (last.out.kind != PathPoint::Inside) return false;
+    const Face& f = mesh_.faces[static_cast<std::size_t>(last.face)];
+    const Eigen::Vector3d hit = pos(last.out, last.face);
+    int best = -1;
+    const double edge = mean_edge(last.face);
+    double nearest = kLipSnapReach * edge;
+    for (int k = 0; k < 3; ++k) {
+      const double d = (mesh_.current.col(f[k]) - hit).norm();
+      // Not the corner the path came in by, nor an end of the edge it came in through (the
+      // chord would run along that edge).
+      const bool behind =
+          (last.in.kind == PathPoint::Vertex && last.in.v == f[k]) ||
+          (last.in.kind == PathPoint::Edge && (last.in.a == f[k] || last.in.b == f[k]));
+      if (d < nearest && std::abs(delta(f[k])) <= kLipSnap * edge && !behind) nearest = d, best = k;
+    }
+    if (best < 0) return false;
+    std::vector<Crossing> path = path_;
+    path.back().out = {PathPoint::Vertex, f[best]};
+    restart_split();
+    points_.push_back(tear_.tip_);
+    for (const Crossing& c : path) split_face(c);
+    const double floor2 = std::pow(std::sin(tear_.options_.min_angle), 2);
+    for (const Face& g : split_.added_faces)
+      if (smallest_angle_sin2(position_of(g[0]), position_of(g[1]), position_of(g[2])) < floor2)
+        return false;
+    path_ = std::move(path);
+    target_ = hit;
+    return true;
+  }
+
+  // Edge flips among the faces the split adds and those beside them, the path's edges kept.
+  void flip_beside_path() {
+    std::vector<std::array<std::int32_t, 2>> path_edges;
+    for (std::size_t i = 0; i + 1 < points_.size(); ++i)
+      path_edges.push_back({points_[i], points_[i + 1]});
+    flip_for_angles(mesh_, adjacency_, split_, path_edges);
+  }
+
+  // Where the tip cannot be at the blade's hit (its faces would be slivers however flipped),
+  // it goes on the nearer of the edge crossings behind and ahead of the hit, within kLipReach of
+  // that edge: an edge crossing lies on Π, so on the track.
+  static constexpr double kLipReach = 0.6;
   bool split_with_nearer_crossing() {
     const Crossing& last = path_.back();
     const Eigen::Vector3d hit = pos(last.out, last.face);
@@ -685,21 +871,6 @@ class TearAdvance {
         ring.push_back(pos(c.in, c.face));
     }
     return ring;
-  }
-
-  // How far (in mean edges of its face) place_tip would move an inside tip at crossing c's hit,
-  // toward the face's middle, to keep its fan above the floor: 0 for any other crossing.
-  double tip_shift(const Crossing& c) const {
-    if (c.out.kind != PathPoint::Inside) return 0;
-    const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
-    const Eigen::Vector3d fa = mesh_.current.col(f[0]), fb = mesh_.current.col(f[1]),
-                          fc = mesh_.current.col(f[2]);
-    const std::vector<Eigen::Vector3d> ring = tip_ring(c);
-    const double min_angle = tear_.options_.min_angle;
-    const auto w = place_tip(c.out.bary, fa, fb, fc, ring, min_angle, nullptr,
-                             std::pow(std::sin(min_angle), 2));
-    const Eigen::Vector3d moved = w[0] * fa + w[1] * fb + w[2] * fc;
-    return (moved - pos(c.out, c.face)).norm() / mean_edge(c.face);
   }
 
   // A face whose corners, split once more, keep the sliver floor (smallest angle ≥ 2 min_angle):
@@ -891,6 +1062,7 @@ class TearAdvance {
     tear_.tip_neighbor_ = points_[points_.size() - 2];
     tear_.tip_ = points_.back();
     tear_.tip_target_ = target_;
+    tear_.tip_off_track_ = off_track_;
     ++tear_.steps_;
     step_.extended = true;
     tear_.message_.clear();
@@ -919,6 +1091,7 @@ class TearAdvance {
   Eigen::Vector3d target_;            // the blade's hit the new tip stands for
   std::vector<std::int32_t> dups_;    // per point, its copy for the left, or −1
   std::vector<Eigen::Vector3d> left_dir_;
+  bool off_track_ = false;  // the new tip was moved off the blade's hit (its fan)
 };
 
 Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, const TearOptions& options)
@@ -973,21 +1146,36 @@ bool Tear::start(const ScalpelSample& s, TearStep& step) {
   const double sum = bary[0] + bary[1] + bary[2];
   for (auto& x : bary) x /= sum;
   const Face f = mesh_.faces[static_cast<std::size_t>(hit)];
-  {
-    const Eigen::Vector3d a = mesh_.current.col(f[0]), b = mesh_.current.col(f[1]),
-                          c = mesh_.current.col(f[2]);
-    tip_target_ = bary[0] * a + bary[1] * b + bary[2] * c;
-    bary = place_tip(bary, a, b, c, {a, b, c}, options_.min_angle);
-  }
-  TopologyChange ch;
-  ch.base_vertex_count = mesh_.vertex_count();
-  ch.base_face_count = mesh_.face_count();
+  const Eigen::Vector3d a = mesh_.current.col(f[0]), b = mesh_.current.col(f[1]),
+                        c = mesh_.current.col(f[2]);
+  tip_target_ = bary[0] * a + bary[1] * b + bary[2] * c;
   const std::int32_t s0 = mesh_.vertex_count();
-  ch.new_vertices.push_back(NewVertex::in_face(f[0], f[1], f[2], bary[0], bary[1], bary[2]));
-  ch.removed_faces = {hit};
-  ch.added_faces = {{f[0], f[1], s0}, {f[1], f[2], s0}, {f[2], f[0], s0}};
+  auto fan_change = [&](const std::array<double, 3>& w) {
+    TopologyChange ch;
+    ch.base_vertex_count = mesh_.vertex_count();
+    ch.base_face_count = mesh_.face_count();
+    ch.new_vertices.push_back(NewVertex::in_face(f[0], f[1], f[2], w[0], w[1], w[2]));
+    ch.removed_faces = {hit};
+    ch.added_faces = {{f[0], f[1], s0}, {f[1], f[2], s0}, {f[2], f[0], s0}};
+    return ch;
+  };
+  // smooth_lips: the start at the hit, the slivers of its fan flipped away (change_flips.hpp);
+  // else (or where flips leave a face below the floor) moved toward the face's incenter.
+  TopologyChange ch = fan_change(bary);
+  bool exact = options_.smooth_lips;
+  if (exact) {
+    flip_for_angles(mesh_, adjacency_, ch, {});
+    auto at = [&](std::int32_t v) {
+      return v == s0 ? tip_target_ : Eigen::Vector3d(mesh_.current.col(v));
+    };
+    const double floor2 = std::pow(std::sin(options_.min_angle), 2);
+    for (const Face& g : ch.added_faces)
+      exact = exact && smallest_angle_sin2(at(g[0]), at(g[1]), at(g[2])) >= floor2;
+  }
+  if (!exact) ch = fan_change(place_tip(bary, a, b, c, {a, b, c}, options_.min_angle));
   commit(std::move(ch), step);
   tip_ = s0;
+  tip_off_track_ = options_.smooth_lips && !exact;
   tip_neighbor_ = f[0];
   path_.push_back({s0, -1, Eigen::Vector3d::Zero()});
   message_.clear();
