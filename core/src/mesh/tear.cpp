@@ -12,6 +12,7 @@
 #include "change_flips.hpp"
 #include "conform/cga/plane.hpp"
 #include "conform/mesh/analysis.hpp"
+#include "lip_refine.hpp"
 #include "quad_split.hpp"
 #include "track_vertex.hpp"
 
@@ -584,9 +585,21 @@ class TearAdvance {
         std::unique(split_.removed_faces.begin(), split_.removed_faces.end()),
         split_.removed_faces.end());
     tear_.commit(std::move(split_), step_);
+    if (smooth) refine_beside_path();
     return true;
   }
 
+  // Steiner points beside the path's new edges where their faces are caps thinner than kLipThin
+  // on a vertex just off the track (lip_refine.hpp), each its own change.
+  static constexpr double kLipThin = 15 * std::numbers::pi / 180;
+  void refine_beside_path() {
+    for (std::size_t i = 0; i < 2 * points_.size(); ++i) {
+      TopologyChange ch =
+          mesh::refine_beside_path(mesh_, adjacency_, points_, kLipThin, tear_.options_.min_angle);
+      if (ch.empty()) return;
+      tear_.commit(std::move(ch), step_);
+    }
+  }
 
   // The lips (TearOptions::smooth_lips): the first of these splits that keeps the new tip on the
   // blade's track and every face it makes at or above min_angle. Else the tip is moved off the
