@@ -79,10 +79,12 @@ double worst(const SkinnedMesh& mesh, const TopologyChange& ch, bool added) {
 }
 
 // The change that puts a Steiner point at the apex of the equilateral triangle on edge (u, v)
-// of face `cap`, on the side of its third vertex `apex`, and flips around it (the path's edges
+// of face `cap`, on the side of its third vertex `apex` (or, `halfway`, midway between the
+// edge's middle and `apex`: where that vertex is the apex of a fan over several short path
+// edges, the point halves the fan's distance to the path), and flips around it (the path's edges
 // `fixed`); empty unless it removes `cap`, raises the smallest angle and keeps the floor.
 TopologyChange steiner(const SkinnedMesh& mesh, const Adjacency& adj, std::int32_t cap,
-                       std::int32_t u, std::int32_t v, std::int32_t apex,
+                       std::int32_t u, std::int32_t v, std::int32_t apex, bool halfway,
                        const std::vector<std::array<std::int32_t, 2>>& fixed, double floor) {
   TopologyChange ch;
   const Eigen::Vector3d pu = at(mesh, u), pv = at(mesh, v), pa = at(mesh, apex);
@@ -90,7 +92,9 @@ TopologyChange steiner(const SkinnedMesh& mesh, const Adjacency& adj, std::int32
   Eigen::Vector3d side = n.cross(e).normalized();
   if (side.dot(pa - pu) < 0) side = -side;
   if (!side.allFinite()) return ch;
-  const Eigen::Vector3d s = 0.5 * (pu + pv) + std::sqrt(3.0) / 2 * e.norm() * side;
+  const Eigen::Vector3d mid = 0.5 * (pu + pv);
+  const Eigen::Vector3d s = halfway ? Eigen::Vector3d(0.5 * (mid + pa))
+                                    : Eigen::Vector3d(mid + std::sqrt(3.0) / 2 * e.norm() * side);
   std::array<double, 3> bary{};
   const std::int32_t face = locate(mesh, adj, cap, s, 0.02, bary);
   if (face < 0) return ch;
@@ -125,8 +129,10 @@ TopologyChange refine_beside_path(const SkinnedMesh& mesh, const Adjacency& adja
       const std::int32_t u = f[h % 3], v = f[(h % 3 + 1) % 3], apex = f[(h % 3 + 2) % 3];
       if (std::find(path.begin(), path.end(), apex) != path.end()) continue;
       if (smallest_angle_sin2(at(mesh, u), at(mesh, v), at(mesh, apex)) >= thin2) continue;
-      TopologyChange ch = steiner(mesh, adjacency, face, u, v, apex, fixed, floor);
-      if (!ch.empty()) return ch;
+      for (const bool halfway : {false, true}) {
+        TopologyChange ch = steiner(mesh, adjacency, face, u, v, apex, halfway, fixed, floor);
+        if (!ch.empty()) return ch;
+      }
     }
   // A face on a path vertex thin at a vertex off the path: the short side opposite it joins the
   // path to a vertex just off the track; the Steiner point goes across that side from the path.
@@ -143,8 +149,10 @@ TopologyChange refine_beside_path(const SkinnedMesh& mesh, const Adjacency& adja
       const std::int32_t w = f[k], u = f[(k + 1) % 3], v = f[(k + 2) % 3];
       if (std::find(path.begin(), path.end(), w) != path.end()) continue;
       if (smallest_angle_sin2(at(mesh, u), at(mesh, v), at(mesh, w)) >= thin2) continue;
-      TopologyChange ch = steiner(mesh, adjacency, face, u, v, w, fixed, floor);
-      if (!ch.empty()) return ch;
+      for (const bool halfway : {false, true}) {
+        TopologyChange ch = steiner(mesh, adjacency, face, u, v, w, halfway, fixed, floor);
+        if (!ch.empty()) return ch;
+      }
     }
   }
   return {};
