@@ -12,9 +12,7 @@
 #include "change_flips.hpp"
 #include "conform/cga/plane.hpp"
 #include "conform/mesh/analysis.hpp"
-#include "lip_refine.hpp"
 #include "quad_split.hpp"
-#include "track_vertex.hpp"
 
 namespace conform::mesh {
 
@@ -585,30 +583,16 @@ class TearAdvance {
         std::unique(split_.removed_faces.begin(), split_.removed_faces.end()),
         split_.removed_faces.end());
     tear_.commit(std::move(split_), step_);
-    if (smooth) refine_beside_path();
     return true;
-  }
-
-  // Steiner points beside the path's new edges where their faces are caps thinner than kLipThin
-  // on a vertex just off the track (lip_refine.hpp), each its own change.
-  static constexpr double kLipThin = 15 * std::numbers::pi / 180;
-  void refine_beside_path() {
-    for (std::size_t i = 0; i < 2 * points_.size(); ++i) {
-      TopologyChange ch =
-          mesh::refine_beside_path(mesh_, adjacency_, points_, kLipThin, tear_.options_.min_angle);
-      if (ch.empty()) return;
-      tear_.commit(std::move(ch), step_);
-    }
   }
 
   // The lips (TearOptions::smooth_lips): the first of these splits that keeps the new tip on the
   // blade's track and every face it makes at or above min_angle. Else the tip is moved off the
   // track toward its face's middle (place_new_tip) and the next step's Π passes through the hit.
   bool split_on_track() {
-    return split_with_tip_on_track_vertex() || split_with_recovered_edges() ||
-           split_with_recovered_edges(true) || split_with_tip_on_edge(kLipBehind) ||
-           split_with_tip_on_corner() || split_with_nearer_crossing() ||
-           split_with_recovered_shifted();
+    return split_with_recovered_edges() || split_with_recovered_edges(true) ||
+           split_with_tip_on_edge(kLipBehind) || split_with_tip_on_corner() ||
+           split_with_nearer_crossing() || split_with_recovered_shifted();
   }
   // The recovered tip moved toward its face's incenter by the first of a few steps that keeps
   // the floor: off the track by less than place_tip's tip (whose step is coarser and whose faces
@@ -734,7 +718,6 @@ class TearAdvance {
       const std::array<double, 3> in{la / p, lb / p, lc / p};
       for (int k = 0; k < 3; ++k) raw[k] = (1 - lambda) * raw[k] + lambda * in[k];
     }
-    const bool lags = lambda == 0 && !on_edge && catch_up(raw, pa, pb, pc, hit);
     restart_split();
     std::vector<std::int32_t> slots;
     points_.push_back(tear_.tip_);
@@ -751,93 +734,6 @@ class TearAdvance {
       for (int k = 0; k < 3; ++k) split_.added_faces.push_back({f[k], f[(k + 1) % 3], tip});
     }
     points_.push_back(tip);
-    if (!join_by_flips(slots)) return false;
-    tip_id_ = tip;
-    target_ = hit;
-    off_track_ = lambda > 0 || lags;
-    return true;
-  }
-
-  // A mesh vertex on the blade's track beside the hit (track_vertex.hpp) becomes the new tip,
-  // joined to the old one by flips: a tip at the hit would join it by a short edge or cap it
-  // with a flat triangle, a fan of thin faces however flipped. The next step's Π goes through
-  // the hit, so that the path does not take on the vertex's offset.
-  bool split_with_tip_on_track_vertex() {
-    const Crossing& last = path_.back();
-    if (last.out.kind != PathPoint::Inside) return false;
-    const Face f = mesh_.faces[static_cast<std::size_t>(last.face)];
-    std::array<double, 3> raw{};
-    if (!segment_triangle(s_.a, s_.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
-                          mesh_.current.col(f[2]), raw))
-      return false;
-    TrackVertexQuery q;
-    q.hit = raw[0] * mesh_.current.col(f[0]) + raw[1] * mesh_.current.col(f[1]) +
-            raw[2] * mesh_.current.col(f[2]);
-    q.previous = tear_.tip_target_;
-    q.sweep = {tear_.previous_.a, tear_.previous_.b, s_.a, s_.b};
-    q.edge = mean_edge(last.face);
-    // The corners of the faces around the hit face's corners, each with a half-edge out of it.
-    std::vector<std::int32_t> slots, candidates, out_of;
-    for (const Crossing& c : path_) slots.push_back(c.face);
-    for (int k = 0; k < 3; ++k)
-      for (const std::int32_t h : fan(adjacency_, 3 * last.face + k)) {
-        const Face& g = mesh_.faces[static_cast<std::size_t>(h / 3)];
-        for (int m = 0; m < 3; ++m)
-          if (g[m] != tear_.tip_ && !on_border(h / 3, m) &&
-              std::find(candidates.begin(), candidates.end(), g[m]) == candidates.end())
-            candidates.push_back(g[m]), out_of.push_back(3 * (h / 3) + m);
-      }
-    const std::int32_t v = track_vertex(mesh_, candidates, q);
-    if (v < 0) return false;
-    const auto i = std::find(candidates.begin(), candidates.end(), v) - candidates.begin();
-    for (const std::int32_t h : fan(adjacency_, out_of[static_cast<std::size_t>(i)]))
-      slots.push_back(h / 3);
-    for (const Crossing& c : path_)
-      if (c.out.kind == PathPoint::Vertex && on_border(c.face, corner_of(c.face, c.out.v)))
-        return false;
-    restart_split();
-    points_.push_back(tear_.tip_);
-    const Eigen::Vector3d along = q.hit - tip_;
-    for (const Crossing& c : path_) {
-      if (c.out.kind != PathPoint::Vertex) continue;
-      if (c.out.v == v) break;
-      if ((mesh_.current.col(c.out.v) - mesh_.current.col(v)).dot(along) < 0)
-        points_.push_back(c.out.v);
-    }
-    points_.push_back(v);
-    if (!join_by_flips(slots)) return false;
-    target_ = q.hit;
-    off_track_ = true;
-    return true;
-  }
-
-  // Even spacing after a tip put behind its hit (on a vertex of the track): the new tip takes up
-  // kLagShare of that lag, on the step's chord behind the hit where that stays inside the hit's
-  // face, so that the step after a short one is not a long one. True when `bary` was moved.
-  static constexpr double kLagShare = 0.5, kLagMin = 0.15;
-  bool catch_up(std::array<double, 3>& bary, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                const Eigen::Vector3d& c, const Eigen::Vector3d& hit) const {
-    if (!tear_.tip_off_track_) return false;
-    const Eigen::Vector3d step = hit - tear_.tip_target_;
-    const double length = step.norm();
-    if (!(length > 0)) return false;
-    const Eigen::Vector3d dir = step / length;
-    const double lag = (tear_.tip_target_ - tip_).dot(dir);
-    if (lag < kLagMin * length) return false;
-    const Eigen::Vector3d p = hit - kLagShare * lag * dir, n = (b - a).cross(c - a);
-    const double n2 = n.squaredNorm();
-    if (!(n2 > 0)) return false;
-    std::array<double, 3> w{(c - b).cross(p - b).dot(n) / n2, (a - c).cross(p - c).dot(n) / n2, 0};
-    w[2] = 1 - w[0] - w[1];
-    if (*std::min_element(w.begin(), w.end()) < kExactMargin) return false;
-    bary = w;
-    return true;
-  }
-
-  // Joins points_ (the old tip … the new tip) by edges that flips make among the change's faces
-  // and the mesh faces `slots` (and those beside them), then flips beside the path; false where
-  // an edge cannot be made or a face the step adds or flips is thinner than min_angle.
-  bool join_by_flips(const std::vector<std::int32_t>& slots) {
     const Eigen::Vector3d blade = s_.b - s_.a;
     for (std::size_t i = 0; i + 1 < points_.size(); ++i) {
       const Eigen::Vector3d n =
@@ -851,6 +747,9 @@ class TearAdvance {
     for (const Face& g : split_.added_faces)
       if (smallest_angle_sin2(position_of(g[0]), position_of(g[1]), position_of(g[2])) < floor2)
         return false;
+    tip_id_ = tip;
+    target_ = hit;
+    off_track_ = lambda > 0;
     return true;
   }
 

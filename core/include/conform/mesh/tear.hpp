@@ -18,10 +18,6 @@
 // The lips (TearOptions::smooth_lips, off by default, issue 18): the path's points are the
 // blade's hits, one per sample, on its track, and the faces beside them keep the sliver floor by
 // edge flips (local re-triangulation) rather than by moving the points.
-//   - A mesh vertex on the track beside the hit (within 0.09 edge of the blade's swept surface,
-//     0.36 step behind or 0.3 step past the hit) is the new tip, joined to the old one by flips:
-//     a tip at the hit would join it by a short edge or cap it with a flat triangle, a fan of
-//     thin faces however flipped. The next tip takes up half of a lag so left (even spacing).
 //   - The new tip is put exactly at the blade's hit (or on the edge of its face it lies on), and
 //     the path's edge from the old tip to it is made by flipping the edges it crosses (a
 //     constrained Delaunay insertion, change_flips.hpp) instead of splitting them at edge
@@ -42,19 +38,13 @@
 //   - A walk that reaches a vertex on a border (the tear's own lips, where a stroke turns about
 //     on itself) stops there like one that meets a boundary, and a tip is not joined to such a
 //     vertex by flips: a path through it would pinch the border.
-//   - After each step, a face beside the path's new edges thinner than 15° (a cap on a vertex
-//     just off the track, or a face thin across its short side to the path) gets a Steiner
-//     point (at the apex of the equilateral triangle on that side, or midway to the vertex),
-//     with flips, where that removes it, raises the smallest angle and keeps the floor: local
-//     refinement beside the tear (lip_refine.hpp).
 //   - open() moves the lips along Π's normals averaged along the path over the opening's width
 //     (Gaussian in arc length), so that a bend of the path does not fold a lip over itself.
 // On tear-opening-like strokes on the arm (tests/mesh_tear_lips_test.cpp) the border's largest
-// distance to the blade's swept surface goes from 0.094 / 0.230 / 0.131 to 0.000 / 0.049 / 0.083
+// distance to the blade's swept surface goes from 0.094 / 0.230 / 0.131 to 0.000 / 0.028 / 0.012
 // local edges (straight / curved / oblique), the largest lip turning after open() from
-// 136° / 166° / 164° to 0.7° / 18° / 24°, the longest over the shortest path segment from
-// 6.8 / 8.4 / 13 to 1.0 / 1.4 / 1.7, and the most faces under 15° on one vertex from 3 / 5 / 5
-// to 0 / 0 / 0.
+// 136° / 166° / 164° to 0.7° / 10° / 3.7°, and the longest over the shortest path segment from
+// 6.8 / 8.4 / 13 to 1.0 / 1.4 / 1.1.
 // Only the start queries the index; every later step is local. Given a FaceIndex, the tear
 // refits it before its query if it was marked moved (FaceIndex::ensure_fitted), updates it for
 // every change it applies, and marks it moved when open() moves positions, so it stays in sync.
