@@ -1,5 +1,6 @@
 #include "oriented_sections.hpp"
 
+#include <algorithm>
 #include <numeric>
 
 namespace conform::mesh::detail {
@@ -41,6 +42,29 @@ struct GroupSection {
   }
 };
 
+// Whether `section`'s triangles (in the concatenation `global` of the loops, each running from
+// offset[l] to offset[l + 1]) run the loops' edges the other way more often than their way.
+// The loops' order comes from the surface's faces, so this is the surface's own orientation:
+// it decides where the signed areas cannot (a loop far from the origin, or folded on itself,
+// whose area's sign is lost to rounding).
+bool runs_against_loops(const SectionTriangulation& section,
+                        const std::vector<std::int32_t>& global,
+                        const std::vector<std::int32_t>& offset) {
+  const auto next = [&](std::int32_t i) {
+    const auto l =
+        std::size_t(std::upper_bound(offset.begin(), offset.end(), i) - offset.begin() - 1);
+    return i + 1 == offset[l + 1] ? offset[l] : i + 1;
+  };
+  long with = 0, against = 0;
+  for (const auto& t : section.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const std::int32_t a = global[std::size_t(t[k])], b = global[std::size_t(t[(k + 1) % 3])];
+      with += next(a) == b;
+      against += next(b) == a;
+    }
+  return against > with;
+}
+
 }  // namespace
 
 OrientedSections oriented_sections(const std::vector<std::vector<Eigen::Vector2d>>& loops,
@@ -77,7 +101,7 @@ OrientedSections oriented_sections(const std::vector<std::vector<Eigen::Vector2d
         (counter_clockwise[group[k]] == (section.depth[k] % 2 == 0) ? as_nested : reversed)
             .push_back(group[k]);
       if (as_nested.size() == group.size() || reversed.size() == group.size()) {
-        inside_out = reversed.size() == group.size();
+        inside_out = runs_against_loops(section, global, offset);
         break;
       }
       // Both kinds (pieces overlapping in the plane): the reversed ones wait, and nest anew
