@@ -287,16 +287,22 @@ class TearAdvance {
     return p.bary[0] * mesh_.current.col(f[0]) + p.bary[1] * mesh_.current.col(f[1]) +
            p.bary[2] * mesh_.current.col(f[2]);
   }
+  // Where the blade crosses `face`, as barycentrics each at least `floor` (then normalized);
+  // false when it does not cross it.
+  bool blade_barycentrics(const Face& f, double floor, std::array<double, 3>& bary) const {
+    if (!segment_triangle(s_.a, s_.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
+                          mesh_.current.col(f[2]), bary))
+      return false;
+    for (auto& x : bary) x = std::max(x, floor);
+    const double sum = bary[0] + bary[1] + bary[2];
+    for (auto& x : bary) x /= sum;
+    return true;
+  }
   // The blade crosses `face`: `out` is the hit, kept snap_fraction inside the face.
   bool blade_hit(std::int32_t face, PathPoint& out) const {
     const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
     std::array<double, 3> bary{};
-    if (!segment_triangle(s_.a, s_.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
-                          mesh_.current.col(f[2]), bary))
-      return false;
-    for (auto& x : bary) x = std::max(x, snap_);
-    const double sum = bary[0] + bary[1] + bary[2];
-    for (auto& x : bary) x /= sum;
+    if (!blade_barycentrics(f, snap_, bary)) return false;
     out.kind = PathPoint::Inside;
     out.bary = bary;
     return true;
@@ -703,12 +709,7 @@ class TearAdvance {
       if (c.out.kind == PathPoint::Vertex && on_border(c.face, corner_of(c.face, c.out.v)))
         return false;
     std::array<double, 3> raw{};
-    if (!segment_triangle(s_.a, s_.b, mesh_.current.col(f[0]), mesh_.current.col(f[1]),
-                          mesh_.current.col(f[2]), raw))
-      return false;
-    for (auto& x : raw) x = std::max(x, kExactMargin);
-    const double sum = raw[0] + raw[1] + raw[2];
-    for (auto& x : raw) x /= sum;
+    if (!blade_barycentrics(f, kExactMargin, raw)) return false;
     const Eigen::Vector3d pa = mesh_.current.col(f[0]), pb = mesh_.current.col(f[1]),
                           pc = mesh_.current.col(f[2]);
     const Eigen::Vector3d hit = raw[0] * pa + raw[1] * pb + raw[2] * pc;
