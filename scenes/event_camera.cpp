@@ -77,6 +77,16 @@ Camera aim_camera(std::span<const FrameSnapshot> panels, const RenderCamera& s, 
   return c;
 }
 
+double strip_view_angle(double panel_view_angle, double aspect, double max_parallax_deg) {
+  // One panel's width at the target, d away: 2 d tan(a/2) aspect. From s times as far, with
+  // tan(a'/2) = tan(a/2) / s, the target's framing is the same, and the next panel, a width
+  // away, is seen at atan(width / (s d)) from the first: at most max_parallax_deg.
+  const double deg = std::numbers::pi / 180;
+  const double half = std::tan(0.5 * panel_view_angle * deg);
+  const double s = std::max(1.0, 2 * half * aspect / std::tan(max_parallax_deg * deg));
+  return 2 * std::atan(half / s) / deg;
+}
+
 StripCamera strip_camera(const Camera& panel, double aspect, double max_parallax_deg) {
   const double deg = std::numbers::pi / 180;
   Eigen::Vector3d back = panel.position - panel.target;
@@ -85,17 +95,33 @@ StripCamera strip_camera(const Camera& panel, double aspect, double max_parallax
   Eigen::Vector3d right = (-back).cross(panel.up);
   if (right.norm() < 1e-9) right = back.unitOrthogonal();
   right.normalize();
-  // One panel's width at the target: 2 d tan(a/2) aspect. From s times as far, with
-  // tan(a'/2) = tan(a/2) / s, the target's framing is the same, and the next panel, a width
-  // away, is seen at atan(width / (s d)) from the first: at most max_parallax_deg.
+  const double angle = strip_view_angle(panel.view_angle, aspect, max_parallax_deg);
   const double half = std::tan(0.5 * panel.view_angle * deg);
-  const double width = 2 * d * half * aspect;
-  const double s = std::max(1.0, width / (d * std::tan(max_parallax_deg * deg)));
-  StripCamera strip{panel, width * right};
+  const double s = half / std::tan(0.5 * angle * deg);  // how many times as far
+  StripCamera strip{panel, 2 * d * half * aspect * right};
   strip.camera.position = panel.target + s * d * back;
-  strip.camera.view_angle = 2 * std::atan(half / s) / deg;
+  strip.camera.view_angle = angle;
   strip.camera.up = back.cross(right);  // the panel's up, made square to the view
   return strip;
+}
+
+ViewFrame view_frame(const Camera& c) {
+  Eigen::Vector3d back = c.position - c.target;
+  const double d = std::max(back.norm(), 1e-12);
+  back /= d;
+  Eigen::Vector3d right = (-back).cross(c.up);
+  if (right.norm() < 1e-9) right = back.unitOrthogonal();
+  right.normalize();
+  ViewFrame f{Eigen::Matrix3d::Identity(), c.position, 1 / d};
+  f.rotation.row(0) = right;
+  f.rotation.row(1) = back.cross(right);
+  f.rotation.row(2) = back;
+  return f;
+}
+
+Camera view_frame_camera(double view_angle) {
+  return {Eigen::Vector3d::Zero(), -Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitY(), view_angle,
+          "view frame"};
 }
 
 }  // namespace conform::scenes

@@ -35,5 +35,24 @@ struct StripCamera {
   Eigen::Vector3d offset(int k, int panels) const { return (k - 0.5 * (panels - 1)) * step; }
 };
 StripCamera strip_camera(const Camera& panel, double aspect, double max_parallax_deg = 1);
+/// strip_camera's view angle, degrees: it depends only on the panel's angle and aspect.
+double strip_view_angle(double panel_view_angle, double aspect, double max_parallax_deg = 1);
+
+/// A camera's view frame, scaled: the eye at the origin, the target at (0, 0, -1), the
+/// picture's right along +x and its up along +y. A surface written in it and seen through
+/// `view_frame_camera(view_angle)` gives the picture the camera gives of the surface itself: a
+/// rigid motion and a uniform scale about the eye move no pixel of a perspective picture, and
+/// f3d's lights follow its camera. So a render's camera is known before the event is, and f3d
+/// can start up while the scene simulates (f3d_render.hpp).
+struct ViewFrame {
+  Eigen::Matrix3d rotation;  // rows: right, up, backwards (from the target to the eye)
+  Eigen::Vector3d eye;
+  double scale;  // 1 / the eye's distance to the target
+  Eigen::Vector3d operator()(const Eigen::Vector3d& x) const {
+    return scale * (rotation * (x - eye));
+  }
+};
+ViewFrame view_frame(const Camera& c);
+Camera view_frame_camera(double view_angle);
 
 }  // namespace conform::scenes

@@ -10,6 +10,7 @@
 
 #include "colour_scale.hpp"
 #include "event_camera.hpp"
+#include "f3d_render.hpp"
 #include "picture_compose.hpp"
 #include "progress.hpp"
 #include "strip_mesh.hpp"
@@ -27,36 +28,10 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-// For sh: single quotes, with any single quote closed, escaped and reopened.
-std::string sq(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-std::string csv3(const Eigen::Vector3d& v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "%.9g,%.9g,%.9g", v.x(), v.y(), v.z());
-  return buf;
-}
-
 std::string stem(const std::string& prefix, int step) {
   char buf[16];
   std::snprintf(buf, sizeof buf, "_%06d", step);
   return prefix + buf;
-}
-
-std::string f3d_command(const std::string& ply, const std::string& png, int width, int height,
-                        const Camera& c) {
-  char angle[32];
-  std::snprintf(angle, sizeof angle, "%.9g", c.view_angle);
-  // --dry-run: no user configuration file, so every run renders alike (and it halves f3d's
-  // start-up). Direct colours (--comp=-2) are the scale's, baked into the PLY.
-  return "f3d --dry-run --quiet " + sq(ply) + " --output " + sq(png) + " --resolution " +
-         std::to_string(width) + "," + std::to_string(height) +
-         " --scalars=RGB --comp=-2 --fxaa --bg-color 1,1,1" + " --camera-position " +
-         csv3(c.position) + " --camera-focal-point " + csv3(c.target) + " --camera-view-up " +
-         csv3(c.up) + " --camera-view-angle " + angle + " > " + sq(png + ".log") + " 2>&1";
 }
 
 }  // namespace
@@ -66,16 +41,39 @@ bool have_tool(const std::string& tool) {
 }
 
 PictureRenderer::PictureRenderer(RenderSettings settings, fs::path dir, std::string title)
-    : settings_(std::move(settings)), dir_(std::move(dir)), title_(std::move(title)) {
+    : settings_(std::move(settings)),
+      dir_(std::move(dir)),
+      title_(std::move(title)),
+      have_f3d_(have_tool("f3d")) {
   // Without a display of our own, a virtual one starts now, while the scene simulates.
   const char* own = std::getenv("DISPLAY");
-  if ((!own || !*own) && have_tool("f3d"))
+  if ((!own || !*own) && have_f3d_)
     display_ = std::make_unique<VirtualDisplay>(std::max(settings_.width, 1280),
                                                 std::max(settings_.height, 1024));
 }
 
 void PictureRenderer::add(std::vector<FrameSnapshot> panels) {
-  if (!panels.empty()) frames_.push_back(std::move(panels));
+  if (panels.empty()) return;
+  if (frames_.empty() && have_f3d_) prestart(panels.size());
+  frames_.push_back(std::move(panels));
+}
+
+// The renders of the last frame start now, with the first frame: f3d starts up while the scene
+// simulates (f3d_render.hpp). The last frame is expected to have as many panels as the first.
+void PictureRenderer::prestart(std::size_t panels) {
+  const fs::path dir = dir_ / "pictures" / "panels";
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) return;  // start() says why
+  const double aspect = double(settings_.width) / settings_.height;
+  const int n = static_cast<int>(panels);
+  const bool one = settings_.perspective && n > 1;  // each panel alone
+  const double angle =
+      one ? settings_.camera.view_angle : strip_view_angle(settings_.camera.view_angle, aspect);
+  for (int k = 0; k < (one ? n : 1); ++k)
+    prestarted_.push_back(std::make_unique<PrestartedRender>(
+        dir, "last_" + std::to_string(k), settings_.width * (one ? 1 : n), settings_.height, angle,
+        display_.get()));
 }
 
 // At most `pictures` frames: the last one and the others evenly spaced before it.
@@ -95,16 +93,21 @@ void warn(Json& report, const std::string& message) {
   report["warnings"].push_back(message);
 }
 
-// Starts the f3d jobs of render.sh, as many at once as there are cores (f3d is single-threaded
-// and spends most of its time starting), on `display` (":N") when conform has none of its own.
-// Returns the running script (to pclose), or nullptr.
+// Writes render.sh: the f3d jobs, as many at once as there are cores (f3d is single-threaded
+// and spends most of its time starting), and as comments the renders that started before their
+// surface existed (`prestarted`). Runs it, when it has jobs, on `display` (":N") when conform
+// has none of its own. Returns the running script (to pclose), or nullptr.
 FILE* launch_panels(const fs::path& pics, const std::vector<std::string>& jobs,
-                    const std::string& display, Json& report) {
+                    const std::vector<std::string>& prestarted, const std::string& display,
+                    Json& report) {
   const unsigned cores = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
   {
     std::ofstream sh(pics / "render.sh");
     sh << "#!/bin/sh\n# Drawn by conform: the f3d renders of this run's panels (from the PLY "
           "inputs, removed once rendered).\ncd \"$(dirname \"$0\")\" || exit 1\n";
+    for (const auto& job : prestarted)
+      sh << "# Started while the scene simulated, reading its surface from a FIFO:\n# " << job
+         << "\n";
     for (std::size_t i = 0; i < jobs.size(); ++i)
       // A line on stdout per rendered frame: conform's progress counts them.
       sh << "{ " << jobs[i] << " && echo rendered; } &\n"
@@ -114,9 +117,10 @@ FILE* launch_panels(const fs::path& pics, const std::vector<std::string>& jobs,
       return nullptr;
     }
   }
-  std::string cmd = "sh " + sq((pics / "render.sh").string());
-  if (!display.empty()) cmd = "DISPLAY=" + sq(display) + " " + cmd;
-  cmd += " 2> " + sq((pics / "render.log").string());
+  if (jobs.empty()) return nullptr;
+  std::string cmd = "sh " + shell_words({(pics / "render.sh").string()});
+  if (!display.empty()) cmd = "DISPLAY=" + shell_words({display}) + " " + cmd;
+  cmd += " 2> " + shell_words({(pics / "render.log").string()});
   FILE* running = ::popen(cmd.c_str(), "r");
   if (!running) warn(report, "cannot start the render script " + (pics / "render.sh").string());
   return running;
@@ -172,7 +176,7 @@ void make_video(const fs::path& dir, const RenderSettings& r, Json& report) {
   const std::string filter =
       r.video == "mp4" ? "-vf 'scale=trunc(iw/2)*2:trunc(ih/2)*2' -c:v libx264 -pix_fmt yuv420p"
                        : "-vf 'split[a][b];[a]palettegen[p];[b][p]paletteuse'";
-  const std::string cmd = "cd " + sq(dir.string()) +
+  const std::string cmd = "cd " + shell_words({dir.string()}) +
                           " && ffmpeg -y -loglevel error -framerate 2 -pattern_type glob -i "
                           "'pictures/step_*.png' " +
                           filter + " " + out + " > pictures/video.log 2>&1";
@@ -203,13 +207,43 @@ struct PictureRenderer::Pending {
   Camera camera{};
   StripCamera strip{};
   fs::path pics;
-  std::vector<fs::path> inputs;
+  std::vector<fs::path> inputs;                                // the PLY files render.sh reads
+  std::vector<std::pair<PrestartedRender*, std::string>> fed;  // and the render each makes
   std::size_t panels = 0;
   FILE* running = nullptr;
 };
 
+// One f3d render's surface: a frame's panels, or one of them, in its camera's view frame.
+struct PictureRenderer::Input {
+  std::string name;  // under pictures/, without extension
+  std::string ply;   // the PLY file's bytes
+  int width;         // pixels
+  double view_angle;
+  bool last;  // of the last frame
+};
+
 PictureRenderer::~PictureRenderer() {
   if (pending_ && pending_->running) ::pclose(pending_->running);
+}
+
+// Every render's surface: one strip per frame (strip_camera), or one per panel through the
+// camera itself.
+std::vector<PictureRenderer::Input> PictureRenderer::inputs(const Pending& p) const {
+  const double aspect = double(settings_.width) / settings_.height;
+  const StripCamera alone{p.camera, Eigen::Vector3d::Zero()};
+  std::vector<Input> out;
+  for (const auto& f : p.frames) {
+    const auto names = renders_of(f, settings_.perspective);
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      const bool one = names.size() > 1;  // a panel alone
+      const std::vector<FrameSnapshot> panels = one ? std::vector{f[k]} : f;
+      const StripCamera& view = one ? alone : p.strip;
+      out.push_back({names[k], strip_ply(panels, p.scale, view, aspect),
+                     settings_.width * static_cast<int>(panels.size()), view.camera.view_angle,
+                     &f == &p.frames.back()});
+    }
+  }
+  return out;
 }
 
 void PictureRenderer::start() {
@@ -217,7 +251,7 @@ void PictureRenderer::start() {
   pending_ = std::make_unique<Pending>();
   Pending& p = *pending_;
   if (frames_.empty()) return;
-  if (!have_tool("f3d")) {
+  if (!have_f3d_) {
     warn(p.report,
          "f3d is not installed (scripts/deps.sh installs f3d, xvfb, ffmpeg): no pictures");
     return;
@@ -231,27 +265,30 @@ void PictureRenderer::start() {
   const double aspect = double(settings_.width) / settings_.height;
   p.camera = aim_camera(p.frames.back(), settings_.camera, aspect);
   p.strip = strip_camera(p.camera, aspect);
-  const StripCamera& strip = p.strip;
   p.pics = dir_ / "pictures";
   fs::create_directories(p.pics / "panels");
-  // One f3d render per frame, of all its panels side by side (strip_camera), or one per panel
-  // through the camera itself.
-  const StripCamera alone{p.camera, Eigen::Vector3d::Zero()};
-  std::vector<std::string> jobs;
-  for (const auto& f : p.frames) {
-    const auto names = renders_of(f, settings_.perspective);
-    for (std::size_t k = 0; k < names.size(); ++k) {
-      const std::string& s = names[k];
-      const bool one = names.size() > 1;  // a panel alone
-      const std::vector<FrameSnapshot> panels = one ? std::vector{f[k]} : f;
-      write_strip_ply(p.pics / (s + ".ply"), panels, p.scale, one ? alone : strip, aspect);
-      p.inputs.push_back(p.pics / (s + ".ply"));
-      const int width = settings_.width * static_cast<int>(panels.size());
-      jobs.push_back(f3d_command(s + ".ply", s + ".png", width, settings_.height,
-                                 one ? p.camera : strip.camera));
-    }
-    p.panels += f.size();
+  for (const auto& f : p.frames) p.panels += f.size();
+  std::vector<Input> renders = inputs(p);
+  // The last frame's renders go to the f3d processes started for them, when those match.
+  std::vector<Input*> to_feed;
+  for (auto& in : renders)
+    if (in.last) to_feed.push_back(&in);
+  bool prestarted = to_feed.size() == prestarted_.size();
+  for (std::size_t k = 0; prestarted && k < to_feed.size(); ++k)
+    prestarted = to_feed[k]->width == prestarted_[k]->width() &&
+                 std::abs(to_feed[k]->view_angle - prestarted_[k]->view_angle()) < 1e-9;
+  std::vector<std::string> jobs, comments;
+  for (const auto& in : renders) {
+    if (prestarted && in.last) continue;
+    const fs::path ply = p.pics / (in.name + ".ply");
+    std::ofstream(ply, std::ios::binary) << in.ply;
+    p.inputs.push_back(ply);
+    jobs.push_back(shell_words(f3d_arguments(in.name + ".ply", in.name + ".png", in.width,
+                                             settings_.height, in.view_angle)) +
+                   " > " + shell_words({in.name + ".png.log"}) + " 2>&1");
   }
+  if (prestarted)
+    for (const auto& r : prestarted_) comments.push_back(shell_words(r->arguments()));
   p.t_render = Clock::now();
   std::string display;
   if (display_) {
@@ -261,23 +298,38 @@ void PictureRenderer::start() {
       return;
     }
   }
-  p.running = launch_panels(p.pics, jobs, display, p.report);
+  p.running = launch_panels(p.pics, jobs, comments, display, p.report);
+  if (!prestarted) return;
+  for (std::size_t k = 0; k < to_feed.size(); ++k) {
+    std::string problem;
+    if (prestarted_[k]->feed(to_feed[k]->ply, problem))
+      p.fed.emplace_back(prestarted_[k].get(), to_feed[k]->name);
+    else
+      warn(p.report, problem);
+  }
 }
 
 Json PictureRenderer::finish() {
   if (!started_) start();
   Pending& p = *pending_;
   Json& report = p.report;
-  if (!p.running) return report;
+  if (!p.running && p.fed.empty()) return report;
   Progress bar("pictures", "render", long(jobs_count(p.frames, settings_.perspective)));
+  long rendered = 0;
+  for (const auto& [render, name] : p.fed) {
+    std::string problem;
+    if (render->finish(problem))
+      fs::rename(render->png(), p.pics / (name + ".png"));
+    else
+      warn(report, problem);
+    bar.update(++rendered);
+  }
   char line[64];
-  for (long rendered = 1; std::fgets(line, sizeof line, p.running); ++rendered)
-    bar.update(rendered);
-  const int rc = ::pclose(p.running);
-  bar.finish();
-  p.running = nullptr;
-  if (rc != 0)
+  while (p.running && std::fgets(line, sizeof line, p.running)) bar.update(++rendered);
+  if (p.running && ::pclose(p.running) != 0)
     warn(report, "the render script failed (see " + (p.pics / "render.log").string() + ")");
+  p.running = nullptr;
+  bar.finish();
   const double render_ms = ms_since(p.t_render);
   for (const auto& in : p.inputs) fs::remove(in);
   std::size_t missing = 0;
@@ -308,6 +360,7 @@ Json PictureRenderer::finish() {
   // f3d's wall time includes the plots drawn meanwhile (RunOutput::finish).
   report["timings"] = {{"panels", p.panels},
                        {"f3d_renders", jobs_count(p.frames, settings_.perspective)},
+                       {"f3d_started_early", p.fed.size()},
                        {"f3d_ms_per_panel", render_ms / double(p.panels)},
                        {"compose_ms", compose_ms},
                        {"video_ms", ms_since(t_video)},

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "f3d_render.hpp"
 #include "frame_snapshot.hpp"
 #include "render_settings.hpp"
 #include "scene_config.hpp"
@@ -48,14 +49,19 @@ class PictureRenderer {
 
  private:
   std::vector<std::size_t> chosen() const;
+  void prestart(std::size_t panels);
   struct Pending;  // a render under way
+  struct Input;    // one render's surface
+  std::vector<Input> inputs(const Pending& p) const;
 
   RenderSettings settings_;
   std::filesystem::path dir_;
   std::string title_;
   std::vector<std::vector<FrameSnapshot>> frames_;
   std::unique_ptr<Pending> pending_;
+  bool have_f3d_ = false;
   std::unique_ptr<VirtualDisplay> display_;  // when conform has no display of its own
+  std::vector<std::unique_ptr<PrestartedRender>> prestarted_;  // the last frame's renders
   bool started_ = false;
 };
 

@@ -4,13 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
 #include <numbers>
-#include <stdexcept>
+#include <sstream>
 
 namespace conform::scenes {
-
-namespace fs = std::filesystem;
 
 namespace {
 
@@ -104,17 +101,18 @@ std::vector<Corner> strip_triangles(const std::vector<FrameSnapshot>& frame,
 
 }  // namespace
 
-void write_strip_ply(const fs::path& path, const std::vector<FrameSnapshot>& frame,
-                     const ColourScale& scale, const StripCamera& strip, double aspect) {
+std::string strip_ply(const std::vector<FrameSnapshot>& frame, const ColourScale& scale,
+                      const StripCamera& strip, double aspect) {
   const std::vector<Corner> soup = strip_triangles(frame, scale, strip, aspect);
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw std::runtime_error("cannot write " + path.string());
+  const ViewFrame view = view_frame(strip.camera);
+  std::ostringstream out(std::ios::binary);
   out << "ply\nformat binary_little_endian 1.0\nelement vertex " << soup.size()
       << "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\n"
          "property uchar green\nproperty uchar blue\nelement face "
       << soup.size() / 3 << "\nproperty list uchar int vertex_indices\nend_header\n";
   for (const Corner& k : soup) {
-    const float f[3] = {float(k.x.x()), float(k.x.y()), float(k.x.z())};
+    const Eigen::Vector3d x = view(k.x);
+    const float f[3] = {float(x.x()), float(x.y()), float(x.z())};
     const std::uint8_t rgb[3] = {byte(k.c[0]), byte(k.c[1]), byte(k.c[2])};
     out.write(reinterpret_cast<const char*>(f), sizeof f);
     out.write(reinterpret_cast<const char*>(rgb), sizeof rgb);
@@ -125,7 +123,7 @@ void write_strip_ply(const fs::path& path, const std::vector<FrameSnapshot>& fra
     out.write(reinterpret_cast<const char*>(&three), 1);
     out.write(reinterpret_cast<const char*>(idx), sizeof idx);
   }
-  if (!out) throw std::runtime_error("cannot write " + path.string());
+  return std::move(out).str();
 }
 
 }  // namespace conform::scenes

@@ -8,7 +8,7 @@
 // of the far inner wall of a hollow limb.
 #pragma once
 
-#include <filesystem>
+#include <string>
 #include <vector>
 
 #include "colour_scale.hpp"
@@ -17,10 +17,11 @@
 
 namespace conform::scenes {
 
-/// Writes `frame`'s panels, left to right, as one binary little-endian PLY with per-vertex
-/// colours (f3d reads them as its "RGB" array); `aspect` is one panel's width / height.
-/// Throws std::runtime_error naming `path` when it cannot be written.
-void write_strip_ply(const std::filesystem::path& path, const std::vector<FrameSnapshot>& frame,
-                     const ColourScale& scale, const StripCamera& strip, double aspect);
+/// `frame`'s panels, left to right, as one binary little-endian PLY with per-vertex colours
+/// (f3d reads them as its "RGB" array), in the view frame of strip.camera (view_frame: seen
+/// through view_frame_camera, it gives strip.camera's picture); `aspect` is one panel's
+/// width / height.
+std::string strip_ply(const std::vector<FrameSnapshot>& frame, const ColourScale& scale,
+                      const StripCamera& strip, double aspect);
 
 }  // namespace conform::scenes

@@ -6,9 +6,10 @@
 // killed by the kernel if conform dies first (PR_SET_PDEATHSIG), so no server outlives a run.
 #pragma once
 
-#include <sys/types.h>
-
+#include <mutex>
 #include <string>
+
+#include "child_process.hpp"
 
 namespace conform::scenes {
 
@@ -17,11 +18,11 @@ class VirtualDisplay {
   /// Starts Xvfb with one screen of width x height x 24 bits on the first free display number
   /// (Xvfb -displayfd). Does not wait for it: see display().
   VirtualDisplay(int width, int height);
-  /// Stops the server (SIGTERM, then waits for it).
+  /// Stops the server (SIGTERM, then waits for it: ChildProcess).
   ~VirtualDisplay();
 
   /// Waits until the server listens (at most 10 s) and returns its display, ":N"; "" when it
-  /// could not start, error() then says why.
+  /// could not start, error() then says why. Safe to call from any thread.
   const std::string& display();
   const std::string& error() const { return error_; }
 
@@ -29,7 +30,8 @@ class VirtualDisplay {
   VirtualDisplay& operator=(const VirtualDisplay&) = delete;
 
  private:
-  pid_t pid_ = -1;
+  ChildProcess server_;
+  std::mutex mutex_;   // display() may be first asked from a render's launching thread
   int ready_fd_ = -1;  // Xvfb writes its display number here once it listens
   std::string display_, error_;
 };

@@ -5,7 +5,7 @@
 // with each frame's vertex and face counts of the PLY frames (read by assimp too), and f3d opens
 // it. A run without f3d on PATH still succeeds, with a warning. The renders need f3d, xvfb and
 // ffmpeg (scripts/deps.sh); conform starts its own Xvfb when there is no display, and a killed
-// run leaves none behind.
+// run leaves none behind, nor the f3d it started early for the last frame.
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <gtest/gtest.h>
@@ -348,9 +348,10 @@ TEST(SceneRenderOff, NoRenderWritesNoPicturesAndNoGlb) {
   EXPECT_TRUE(fs::exists(out / "frames" / "physics_000060.ply"));
 }
 
-// Without a display conform starts its own Xvfb when the run begins (virtual_display.hpp); a
-// run killed while it lives must not leave it behind.
-TEST(SceneRenderDisplay, AKilledRunLeavesNoXvfbBehind) {
+// Without a display conform starts its own Xvfb when the run begins (virtual_display.hpp), and
+// with the run's first frame the f3d that will render its last one (f3d_render.hpp), which then
+// waits for its surface. A run killed meanwhile must leave neither behind.
+TEST(SceneRenderDisplay, AKilledRunLeavesNoXvfbNorF3dBehind) {
   const fs::path out =
       fs::temp_directory_path() / ("conform_scene_render_kill_" + std::to_string(::getpid()));
   fs::remove_all(out);
@@ -370,22 +371,28 @@ TEST(SceneRenderDisplay, AKilledRunLeavesNoXvfbBehind) {
     if (p) pclose(p);
     return std::string(buf);
   };
-  // Its Xvfb child, once started.
-  int xvfb = 0;
-  for (int i = 0; i < 200 && xvfb == 0; ++i) {
-    xvfb = std::atoi(first_line("pgrep -P " + std::to_string(run) + " -x Xvfb").c_str());
-    if (xvfb == 0) usleep(50000);
-  }
+  // Its children, once started.
+  const auto child = [&](const char* name) {
+    int pid = 0;
+    for (int i = 0; i < 200 && pid == 0; ++i) {
+      pid = std::atoi(first_line("pgrep -P " + std::to_string(run) + " -x " + name).c_str());
+      if (pid == 0) usleep(50000);
+    }
+    return pid;
+  };
+  const int xvfb = child("Xvfb"), f3d = child("f3d");
   ::kill(run, SIGKILL);
   ASSERT_GT(xvfb, 0) << "the run started no Xvfb";
+  ASSERT_GT(f3d, 0) << "the run started no f3d for its last frame";
   // Gone (or a zombie waiting for its new parent to reap it) within 5 s.
-  const auto alive = [&] {
-    const std::string stat = read_text("/proc/" + std::to_string(xvfb) + "/stat");
+  const auto alive = [&](int pid) {
+    const std::string stat = read_text("/proc/" + std::to_string(pid) + "/stat");
     const auto close = stat.rfind(')');
     return close != std::string::npos && close + 2 < stat.size() && stat[close + 2] != 'Z';
   };
-  for (int i = 0; i < 100 && alive(); ++i) usleep(50000);
-  EXPECT_FALSE(alive()) << "Xvfb " << xvfb << " outlived its run";
+  for (int i = 0; i < 100 && (alive(xvfb) || alive(f3d)); ++i) usleep(50000);
+  EXPECT_FALSE(alive(xvfb)) << "Xvfb " << xvfb << " outlived its run";
+  EXPECT_FALSE(alive(f3d)) << "f3d " << f3d << " outlived its run";
   // The killed run's staging folder and lock file (output_folder.hpp).
   const std::string mine = "." + out.filename().string() + ".";
   for (const auto& e : fs::directory_iterator(out.parent_path()))
