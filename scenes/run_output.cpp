@@ -223,11 +223,6 @@ std::vector<std::string> draw_plots(const fs::path& dir, const std::vector<Plot>
   return problems;
 }
 
-bool draw_plot(const fs::path& dir, const Plot& plot, std::string& problem) {
-  problem = draw_plots(dir, {plot}).front();
-  return problem.empty();
-}
-
 bool have_gnuplot() {
   return std::system("command -v gnuplot > /dev/null 2>&1") == 0;
 }

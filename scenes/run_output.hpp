@@ -133,12 +133,9 @@ class RunOutput {
   std::unique_ptr<Progress> progress_;
 };
 
-/// Draws `plot` into dir/NAME.png with gnuplot (the script is kept as dir/NAME.gp); series
-/// files are relative to `dir`. False with `problem` set when gnuplot failed or is missing.
-/// RunOutput and `conform sweep` draw through this one function.
-bool draw_plot(const std::filesystem::path& dir, const Plot& plot, std::string& problem);
-/// Draws every plot as draw_plot does, in one gnuplot process; returns each plot's problem
-/// ("" when drawn).
+/// Draws each plot into dir/NAME.png (its script kept as dir/NAME.gp; series files relative to
+/// `dir`), all in one gnuplot process; returns each plot's problem ("" when drawn). RunOutput
+/// and `conform sweep` draw through this one function.
 std::vector<std::string> draw_plots(const std::filesystem::path& dir,
                                     const std::vector<Plot>& plots);
 /// Whether gnuplot is on the PATH.

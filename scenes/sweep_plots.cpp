@@ -118,7 +118,7 @@ SweepPlots draw_sweep_plots(const SweepSpec& spec, const SweepTable& table, cons
     result.problems.push_back("cannot create " + (plots_dir / "data").string());
     return result;
   }
-  const bool gnuplot = have_gnuplot();
+  std::vector<Plot> plots;
   for (const auto& metric : plot_metrics(spec)) {
     if (!table.rows.empty() && std::find(table.columns.begin(), table.columns.end(),
                                          "metrics." + metric) == table.columns.end()) {
@@ -136,16 +136,22 @@ SweepPlots draw_sweep_plots(const SweepSpec& spec, const SweepTable& table, cons
       int numbers = 0;
       for (const auto& value : spec.axes[x].values) numbers += numeric(value, v);
       if (numbers < 2) continue;  // a key of words, or one value: only a line label
-      const Plot plot = sweep_plot(spec, table, x, metric, plots_dir);
-      std::string problem = "gnuplot is not installed (scripts/deps.sh installs gnuplot-nox)";
+      Plot plot = sweep_plot(spec, table, x, metric, plots_dir);
       if (plot.series.empty())
         result.problems.push_back(plot.name + ": no finished run has " + metric);
-      else if (gnuplot && draw_plot(plots_dir, plot, problem))
-        result.drawn.push_back((plots_dir / (plot.name + ".png")).string());
       else
-        result.problems.push_back(plot.name + ": " + problem);
+        plots.push_back(std::move(plot));
     }
   }
+  // All in one gnuplot process (draw_plots): its start-up is most of a small plot's cost.
+  std::vector<std::string> problems(
+      plots.size(), "gnuplot is not installed (scripts/deps.sh installs gnuplot-nox)");
+  if (!plots.empty() && have_gnuplot()) problems = draw_plots(plots_dir, plots);
+  for (std::size_t i = 0; i < plots.size(); ++i)
+    if (problems[i].empty())
+      result.drawn.push_back((plots_dir / (plots[i].name + ".png")).string());
+    else
+      result.problems.push_back(plots[i].name + ": " + problems[i]);
   return result;
 }
 

@@ -1,7 +1,7 @@
 // The plots of a sweep: each chosen metric against each grid key that has at least two
 // numeric values, one line per combination of the other keys' values (repeats averaged; keys
 // zipped with the plotted one move along its line),
-// drawn by gnuplot through draw_plot (run_output.hpp) into DIR/plots/METRIC_vs_KEY.png, with
+// drawn by one gnuplot through draw_plots (run_output.hpp) into DIR/plots/METRIC_vs_KEY.png, with
 // the data of every line in DIR/plots/data/.
 #pragma once
 
