@@ -4,13 +4,15 @@
 // a colour bar and a title (composed with cairo, picture_compose.hpp), the inside of the skin as
 // a wound bed, and a short video of the pictures (ffmpeg).
 //
-// The wound bed and the panels side by side: strip_mesh.hpp.
+// The wound bed and the panels side by side: strip_mesh.hpp. The last frame's f3d starts with
+// the run's first frame and waits for its surface while the scene simulates (f3d_render.hpp).
 //
 // Written into the run folder:
 //   pictures/step_STEP.png        the side-by-side picture of one frame
 //   pictures/panels/strip_STEP.png the frame's panels side by side as f3d rendered them
 //                                 (NAME_STEP.png, one per panel, with render.perspective)
-//   pictures/render.sh            the f3d script that made the panels (re-runnable by hand)
+//   pictures/render.sh            the f3d commands that made the panels, for the record (their
+//                                 PLY inputs are removed once rendered)
 //   run.gif or run.mp4            the pictures in turn (when there are 2 or more)
 // A missing tool (f3d, Xvfb, ffmpeg) is a warning, never a failed run.
 #pragma once
