@@ -268,28 +268,6 @@ void PictureRenderer::start() {
   p.pics = dir_ / "pictures";
   fs::create_directories(p.pics / "panels");
   for (const auto& f : p.frames) p.panels += f.size();
-  std::vector<Input> renders = inputs(p);
-  // The last frame's renders go to the f3d processes started for them, when those match.
-  std::vector<Input*> to_feed;
-  for (auto& in : renders)
-    if (in.last) to_feed.push_back(&in);
-  bool prestarted = to_feed.size() == prestarted_.size();
-  for (std::size_t k = 0; prestarted && k < to_feed.size(); ++k)
-    prestarted = to_feed[k]->width == prestarted_[k]->width() &&
-                 std::abs(to_feed[k]->view_angle - prestarted_[k]->view_angle()) < 1e-9;
-  std::vector<std::string> jobs, comments;
-  for (const auto& in : renders) {
-    if (prestarted && in.last) continue;
-    const fs::path ply = p.pics / (in.name + ".ply");
-    std::ofstream(ply, std::ios::binary) << in.ply;
-    p.inputs.push_back(ply);
-    jobs.push_back(shell_words(f3d_arguments(in.name + ".ply", in.name + ".png", in.width,
-                                             settings_.height, in.view_angle)) +
-                   " > " + shell_words({in.name + ".png.log"}) + " 2>&1");
-  }
-  if (prestarted)
-    for (const auto& r : prestarted_) comments.push_back(shell_words(r->arguments()));
-  p.t_render = Clock::now();
   std::string display;
   if (display_) {
     display = display_->display();
@@ -298,15 +276,39 @@ void PictureRenderer::start() {
       return;
     }
   }
-  p.running = launch_panels(p.pics, jobs, comments, display, p.report);
-  if (!prestarted) return;
-  for (std::size_t k = 0; k < to_feed.size(); ++k) {
-    std::string problem;
-    if (prestarted_[k]->feed(to_feed[k]->ply, problem))
-      p.fed.emplace_back(prestarted_[k].get(), to_feed[k]->name);
-    else
-      warn(p.report, problem);
+  p.t_render = Clock::now();
+  std::vector<std::string> jobs, comments;
+  std::size_t last = 0;  // the last frame's renders so far
+  for (const auto& in : inputs(p)) {
+    if (in.last && feed_prestarted(last++, in, p)) {
+      comments.push_back(shell_words(prestarted_[last - 1]->arguments()));
+      continue;
+    }
+    const fs::path ply = p.pics / (in.name + ".ply");
+    std::ofstream(ply, std::ios::binary) << in.ply;
+    p.inputs.push_back(ply);
+    jobs.push_back(shell_words(f3d_arguments(in.name + ".ply", in.name + ".png", in.width,
+                                             settings_.height, in.view_angle)) +
+                   " > " + shell_words({in.name + ".png.log"}) + " 2>&1");
   }
+  p.running = launch_panels(p.pics, jobs, comments, display, p.report);
+}
+
+// Hands render `in`, the k-th of the last frame, to the f3d started for it, when that one
+// renders the same size through the same view angle and is still there to take it (otherwise
+// it is rendered anew).
+bool PictureRenderer::feed_prestarted(std::size_t k, const Input& in, Pending& p) {
+  if (k >= prestarted_.size()) return false;
+  PrestartedRender& r = *prestarted_[k];
+  if (r.width() != in.width || std::abs(r.view_angle() - in.view_angle) > 1e-9) return false;
+  std::string problem;
+  if (!r.feed(in.ply, problem)) {
+    p.report["notes"].push_back("the f3d started early for " + in.name +
+                                " could not take its surface (" + problem + "): rendered anew");
+    return false;
+  }
+  p.fed.emplace_back(&r, in.name);
+  return true;
 }
 
 Json PictureRenderer::finish() {

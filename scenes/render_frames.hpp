@@ -55,6 +55,7 @@ class PictureRenderer {
   struct Pending;  // a render under way
   struct Input;    // one render's surface
   std::vector<Input> inputs(const Pending& p) const;
+  bool feed_prestarted(std::size_t k, const Input& in, Pending& p);
 
   RenderSettings settings_;
   std::filesystem::path dir_;

@@ -132,6 +132,10 @@ TEST_F(SceneRender, RunSucceedsAndReportsItsRenders) {
   EXPECT_EQ(r["camera"]["aimed_at"], "event");
   EXPECT_GT(r["render_ms_per_picture"].get<double>(), 0);
   EXPECT_GT(r["sim_ms_per_step"].get<double>(), 0);
+  // The last frame's f3d started with the first frame (f3d_render.hpp); the other frame's ran
+  // from render.sh.
+  EXPECT_EQ(r["timings"]["f3d_started_early"], 1);
+  EXPECT_FALSE(r.contains("notes")) << r["notes"].dump();
 }
 
 TEST_F(SceneRender, PicturesHaveTheRequestedSizeAndShowTheWound) {
@@ -397,6 +401,41 @@ TEST(SceneRenderDisplay, AKilledRunLeavesNoXvfbNorF3dBehind) {
   const std::string mine = "." + out.filename().string() + ".";
   for (const auto& e : fs::directory_iterator(out.parent_path()))
     if (e.path().filename().string().rfind(mine, 0) == 0) fs::remove_all(e.path());
+}
+
+// The f3d started early for the last frame may die before its surface comes (here an f3d on
+// PATH that fails whenever it is given the early render's FIFO, and is the real f3d otherwise):
+// the frame is then rendered anew, and the run says so.
+TEST(SceneRenderEarly, AnEarlyF3dThatDiesIsReplaced) {
+  const fs::path out =
+      fs::temp_directory_path() / ("conform_scene_render_early_" + std::to_string(::getpid()));
+  const fs::path bin = out.string() + ".bin";
+  fs::create_directories(bin);
+  {
+    std::ofstream f3d(bin / "f3d");
+    f3d << "#!/bin/sh\nfor a in \"$@\"; do case \"$a\" in */last_0.ply) exit 3;; esac; "
+           "done\nexec /usr/bin/f3d \"$@\"\n";
+  }
+  fs::permissions(bin / "f3d", fs::perms::owner_all);
+  ASSERT_EQ(run_conform("--set render.width=" + std::to_string(kWidth) + " --set render.height=" +
+                            std::to_string(kHeight) + " --set outputs.plots=false",
+                        out, "env PATH=" + bin.string() + ":$PATH"),
+            0);
+  const Json s = Json::parse(read_text(out / "summary.json"), nullptr, false);
+  ASSERT_TRUE(s.is_object());
+  const Json& r = s["render"];
+  ASSERT_EQ(r["pictures"].size(), 1u) << r.dump(1);
+  EXPECT_EQ(png_size(out / "pictures/panels/strip_000060.png"),
+            (std::array<int, 2>{2 * kWidth, kHeight}));
+  EXPECT_GT(foreground(pixels(out / "pictures/panels/strip_000060.png", panel_crop(0))),
+            kWidth * kHeight / 5);
+  EXPECT_EQ(r["timings"]["f3d_started_early"], 0);
+  ASSERT_TRUE(r.contains("notes"));
+  EXPECT_NE(r["notes"][0].get<std::string>().find("rendered anew"), std::string::npos);
+  EXPECT_TRUE(r["warnings"].empty()) << r.dump(1);
+  fs::remove_all(out);
+  fs::remove_all(bin);
+  fs::remove(out.string() + ".log");
 }
 
 TEST(SceneRenderOff, MissingF3dIsAWarningNotAFailure) {
