@@ -87,24 +87,6 @@ double strip_view_angle(double panel_view_angle, double aspect, double max_paral
   return 2 * std::atan(half / s) / deg;
 }
 
-StripCamera strip_camera(const Camera& panel, double aspect, double max_parallax_deg) {
-  const double deg = std::numbers::pi / 180;
-  Eigen::Vector3d back = panel.position - panel.target;
-  const double d = std::max(back.norm(), 1e-9);
-  back /= d;
-  Eigen::Vector3d right = (-back).cross(panel.up);
-  if (right.norm() < 1e-9) right = back.unitOrthogonal();
-  right.normalize();
-  const double angle = strip_view_angle(panel.view_angle, aspect, max_parallax_deg);
-  const double half = std::tan(0.5 * panel.view_angle * deg);
-  const double s = half / std::tan(0.5 * angle * deg);  // how many times as far
-  StripCamera strip{panel, 2 * d * half * aspect * right};
-  strip.camera.position = panel.target + s * d * back;
-  strip.camera.view_angle = angle;
-  strip.camera.up = back.cross(right);  // the panel's up, made square to the view
-  return strip;
-}
-
 ViewFrame view_frame(const Camera& c) {
   Eigen::Vector3d back = c.position - c.target;
   const double d = std::max(back.norm(), 1e-12);
@@ -117,6 +99,21 @@ ViewFrame view_frame(const Camera& c) {
   f.rotation.row(1) = back.cross(right);
   f.rotation.row(2) = back;
   return f;
+}
+
+StripCamera strip_camera(const Camera& panel, double aspect, double max_parallax_deg) {
+  const double deg = std::numbers::pi / 180;
+  const ViewFrame view = view_frame(panel);
+  const Eigen::Vector3d right = view.rotation.row(0), back = view.rotation.row(2);
+  const double d = 1 / view.scale;
+  const double angle = strip_view_angle(panel.view_angle, aspect, max_parallax_deg);
+  const double half = std::tan(0.5 * panel.view_angle * deg);
+  const double s = half / std::tan(0.5 * angle * deg);  // how many times as far
+  StripCamera strip{panel, 2 * d * half * aspect * right};
+  strip.camera.position = panel.target + s * d * back;
+  strip.camera.view_angle = angle;
+  strip.camera.up = view.rotation.row(1);  // the panel's up, made square to the view
+  return strip;
 }
 
 Camera view_frame_camera(double view_angle) {
