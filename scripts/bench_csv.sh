@@ -23,7 +23,8 @@ while (($#)); do
   esac
 done
 if ((${#programs[@]} == 0)); then
-  programs=("cga_bench:^BM_(MotorCompose|MotorPointBatch)$" "ik_bench:^BM_(ScalarFast|ArmIk)/double$")
+  programs=("cga_bench:^BM_(MotorCompose|MotorPointBatch)$" "ik_bench:^BM_(ScalarFast|ArmIk)/double$"
+    "tear_drill_bench:^BM_Tear100(Lips)?/faces:(0|50000)/index")
 fi
 if [[ -z "$machine" ]]; then
   cpu="$(lscpu 2>/dev/null | sed -n 's/^Model name:[[:space:]]*//p' | head -n1)"
