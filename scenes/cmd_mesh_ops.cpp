@@ -289,7 +289,11 @@ void register_tear(CLI::App& app, Context& context) {
   cmd->add_option("--scalpel", *scalpel, "CSV with header t,ax,ay,az,bx,by,bz")->required();
   cmd->add_option("--open", *open, "move the tear's two borders apart by this much (m)")
       ->check(CLI::NonNegativeNumber);
-  cmd->callback([&context, common, scalpel, open]() {
+  auto options = std::make_shared<mesh::TearOptions>();
+  cmd->add_flag("--smooth-lips", options->smooth_lips,
+                "place each new tip at the blade's hit and join it by edge flips, as the scenes "
+                "do: smooth, evenly spaced lips (default: the paper's path along edge crossings)");
+  cmd->callback([&context, common, scalpel, open, options]() {
     run(context, "tear", [&] {
       nlohmann::json summary;
       summary["command"] = "tear";
@@ -299,12 +303,13 @@ void register_tear(CLI::App& app, Context& context) {
       mesh::Adjacency adjacency(m);
       const double t_adj = ms_since(t0);
       const auto t1 = Clock::now();
-      mesh::Tear tear(m, adjacency);
+      mesh::Tear tear(m, adjacency, *options);
       for (const auto& s : samples) tear.advance(s);
       if (*open > 0) tear.open(*open);
       summary["timing_ms"]["adjacency"] = t_adj;
       summary["timing_ms"]["operation"] = ms_since(t1);
       summary["samples"] = samples.size();
+      summary["smooth_lips"] = options->smooth_lips;
       summary["tear"] = {
           {"steps", tear.steps()}, {"points", tear.path_length()}, {"length", tear.length()}};
       if (!tear.message().empty()) summary["message"] = tear.message();

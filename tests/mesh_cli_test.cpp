@@ -140,6 +140,19 @@ TEST_F(MeshCli, DrillAndTear) {
   EXPECT_EQ(s["tear"]["steps"], 49);
   EXPECT_EQ(s["output"]["pieces"], 1);
   expect_only_outputs(out, 1, ".ply");
+  // --smooth-lips, as the scenes tear: one path point per sample, on the blade's track (0.1 m
+  // long); the paper's path along edge crossings zigzags about it (0.1156 m, 73 points).
+  const fs::path smooth = t / "smooth";
+  ASSERT_EQ(run("tear arm --smooth-lips --scalpel " + (t / "scalpel.csv").string() +
+                " --open 0.004 --out " + smooth.string()),
+            0);
+  const auto l = summary(smooth);
+  EXPECT_EQ(l["smooth_lips"], true);
+  EXPECT_EQ(l["tear"]["points"], 50);
+  EXPECT_NEAR(l["tear"]["length"].get<double>(), 0.1, 0.001);
+  EXPECT_GT(s["tear"]["length"].get<double>(), 0.11);
+  EXPECT_EQ(l["output"]["manifold"], true);
+  EXPECT_EQ(l["output"]["oriented"], true);
   fs::remove_all(t);
 }
 
