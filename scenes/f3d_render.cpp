@@ -107,7 +107,8 @@ void PrestartedRender::launch(VirtualDisplay* display) {
   options.log = png_.string() + ".log";
   const std::string d = display ? display->display() : std::string();
   std::unique_lock lock(mutex_);
-  if (display && d.empty()) launch_error_ = display->error();
+  if (stopping_) launch_error_ = "stopped before it started";
+  if (display && d.empty() && launch_error_.empty()) launch_error_ = display->error();
   if (display) options.env.push_back("DISPLAY=" + d);
   ChildProcess f3d;
   if (launch_error_.empty()) f3d = ChildProcess(args_, options);
@@ -132,6 +133,7 @@ void PrestartedRender::launch(VirtualDisplay* display) {
 
 void PrestartedRender::stop() {
   std::lock_guard lock(mutex_);
+  stopping_ = true;  // a launch still waiting for the display then starts nothing
   if (pid_ > 0 && !ended_) ::kill(pid_, SIGTERM);
 }
 

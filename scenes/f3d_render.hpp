@@ -73,9 +73,10 @@ class PrestartedRender {
   bool fed_ = false;
   std::mutex mutex_;  // guards the state below, shared with the launching thread
   std::condition_variable changed_;
-  pid_t pid_ = -1;      // f3d, once started
-  bool ended_ = false;  // f3d has exited (or was never started), launch_error_ then says why
-  int status_ = -1;     // f3d's exit status, once reaped
+  pid_t pid_ = -1;         // f3d, once started
+  bool stopping_ = false;  // stop() came: no f3d is to be started any more
+  bool ended_ = false;     // f3d has exited (or was never started), launch_error_ then says why
+  int status_ = -1;        // f3d's exit status, once reaped
   std::string launch_error_;
   std::thread launcher_;  // last: it starts once the members above are made
 };
