@@ -63,16 +63,6 @@ ChildProcess::ChildProcess(const std::vector<std::string>& args, const ChildOpti
   if (pid_ < 0) error_ = "cannot start " + args.front() + ": " + std::strerror(errno);
 }
 
-bool ChildProcess::exited() {
-  if (pid_ <= 0) return true;
-  int status = 0;
-  const pid_t r = ::waitpid(pid_, &status, WNOHANG);
-  if (r == 0) return false;
-  status_ = r == pid_ ? exit_status(status) : -1;
-  pid_ = -1;
-  return true;
-}
-
 int ChildProcess::wait() {
   if (pid_ <= 0) return status_;
   int status = 0;

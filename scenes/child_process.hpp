@@ -29,8 +29,6 @@ class ChildProcess {
   pid_t pid() const { return pid_; }
   const std::string& error() const { return error_; }
 
-  /// True once the child has exited (reaping it); never blocks.
-  bool exited();
   /// Waits for the child to exit and returns its exit status (128 + the signal when killed,
   /// -1 when it never ran).
   int wait();

@@ -41,9 +41,6 @@ class PrestartedRender {
   /// Stops f3d if it still runs and removes the FIFO.
   ~PrestartedRender();
 
-  /// Waits until f3d is started (or could not be): false, with `problem` set, when it could
-  /// not.
-  bool started(std::string& problem);
   /// Hands the surface (a whole PLY file) to f3d. False, with `problem` set, when f3d is not
   /// there to take it (it exited; it then waits no more than 30 s for f3d to open the FIFO).
   bool feed(const std::string& ply, std::string& problem);
@@ -65,6 +62,9 @@ class PrestartedRender {
   // (ChildProcess) follows the thread that forked, not the process.
   void launch(VirtualDisplay* display);
   void stop();
+  // Waits until f3d is started (or could not be): false, with `problem` set, when it could
+  // not.
+  bool started(std::string& problem);
 
   std::filesystem::path fifo_, png_;
   std::vector<std::string> args_;

@@ -28,6 +28,12 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+// With "perspective" each panel of a frame is its own render, through the camera itself;
+// otherwise, or with a single panel, the frame's panels are one strip (strip_camera).
+bool each_panel_alone(bool perspective, std::size_t panels) {
+  return perspective && panels > 1;
+}
+
 std::string stem(const std::string& prefix, int step) {
   char buf[16];
   std::snprintf(buf, sizeof buf, "_%06d", step);
@@ -67,7 +73,7 @@ void PictureRenderer::prestart(std::size_t panels) {
   if (ec) return;  // start() says why
   const double aspect = double(settings_.width) / settings_.height;
   const int n = static_cast<int>(panels);
-  const bool one = settings_.perspective && n > 1;  // each panel alone
+  const bool one = each_panel_alone(settings_.perspective, panels);
   const double angle =
       one ? settings_.camera.view_angle : strip_view_angle(settings_.camera.view_angle, aspect);
   for (int k = 0; k < (one ? n : 1); ++k)
@@ -235,7 +241,7 @@ std::vector<PictureRenderer::Input> PictureRenderer::inputs(const Pending& p) co
   for (const auto& f : p.frames) {
     const auto names = renders_of(f, settings_.perspective);
     for (std::size_t k = 0; k < names.size(); ++k) {
-      const bool one = names.size() > 1;  // a panel alone
+      const bool one = each_panel_alone(settings_.perspective, f.size());
       const std::vector<FrameSnapshot> panels = one ? std::vector{f[k]} : f;
       const StripCamera& view = one ? alone : p.strip;
       out.push_back({names[k], strip_ply(panels, p.scale, view, aspect),

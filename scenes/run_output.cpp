@@ -224,7 +224,7 @@ std::vector<std::string> draw_plots(const fs::path& dir, const std::vector<Plot>
 }
 
 bool have_gnuplot() {
-  return std::system("command -v gnuplot > /dev/null 2>&1") == 0;
+  return have_tool("gnuplot");
 }
 
 namespace {
