@@ -1,6 +1,7 @@
 // The `conform skin` command writes what the library computes (world space, one file per
 // frame) and fails cleanly on bad arguments. Needs the `conform` binary of this build tree.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -65,9 +66,15 @@ class SkinCli : public testing::Test {
  protected:
   void SetUp() override {
     if (!fs::exists(kConform)) GTEST_SKIP() << "conform not built";
-    dir = fs::path(testing::TempDir()) / "conform_skin_cli";
+    // One folder per test process: ctest runs this file's tests in parallel processes, and a
+    // shared folder let one test's SetUp delete another's outputs while it read them.
+    dir = fs::path(testing::TempDir()) / ("conform_skin_cli_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir, ec);
   }
   fs::path dir;
 };
