@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# The command line's attack campaign (scripts/cli_campaign.py) at a small fixed budget: --out
+# values, scalpel CSVs, scene files, extreme numbers, signals at random times and concurrent
+# runs, each inside a throw-away home of the user's files. Fails on any defect it counts:
+# a user's file touched, an injected command run, an orphan, a staging folder left, an exit
+# code that does not match the outcome, a hang or a non-model input growing past 512 MiB.
+set -euo pipefail
+conform="$1"
+root="$2"
+runs="${CONFORM_CAMPAIGN_RUNS:-240}"
+if [[ -n "${CONFORM_SANITIZED:-}" ]]; then runs=60; fi  # the sanitized binary is 5-10x slower
+exec /usr/bin/python3 "$root/scripts/cli_campaign.py" --conform "$conform" --runs "$runs" \
+  --seed 1 --jobs 2 --limit 30
