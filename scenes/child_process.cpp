@@ -9,6 +9,8 @@
 #include <cerrno>
 #include <cstring>
 
+#include "interrupt.hpp"
+
 extern char** environ;
 
 namespace conform::scenes {
@@ -17,10 +19,11 @@ namespace {
 
 // In the child, between fork and exec: only async-signal-safe calls (everything the exec needs
 // was made before the fork, which may come from any of conform's threads).
-[[noreturn]] void exec_child(pid_t parent, char* const argv[], char* const envp[],
-                             const char* log) {
+[[noreturn]] void exec_child(pid_t parent, char* const argv[], char* const envp[], const char* log,
+                             const char* dir) {
   ::prctl(PR_SET_PDEATHSIG, SIGKILL);
   if (::getppid() != parent) ::_exit(127);  // the parent died before prctl took effect
+  if (*dir && ::chdir(dir) != 0) ::_exit(127);
   const int null = ::open("/dev/null", O_RDWR);
   const int out = *log ? ::open(log, O_WRONLY | O_CREAT | O_TRUNC, 0644) : null;
   if (null >= 0) ::dup2(null, 0);
@@ -59,12 +62,19 @@ ChildProcess::ChildProcess(const std::vector<std::string>& args, const ChildOpti
   if (options.keep_fd >= 0) ::fcntl(options.keep_fd, F_SETFD, 0);
   const pid_t parent = ::getpid();
   pid_ = ::fork();
-  if (pid_ == 0) exec_child(parent, argv.data(), envp.data(), options.log.c_str());
+  if (pid_ == 0)
+    exec_child(parent, argv.data(), envp.data(), options.log.c_str(), options.dir.c_str());
   if (pid_ < 0) error_ = "cannot start " + args.front() + ": " + std::strerror(errno);
+  if (pid_ > 0) register_child(pid_);
 }
 
 int ChildProcess::wait() {
   if (pid_ <= 0) return status_;
+  // Unregistered once it has exited but before it is reaped: until then its pid is not reused.
+  siginfo_t info;
+  while (::waitid(P_PID, id_t(pid_), &info, WEXITED | WNOWAIT) < 0 && errno == EINTR) {
+  }
+  unregister_child(pid_);
   int status = 0;
   pid_t r;
   while ((r = ::waitpid(pid_, &status, 0)) < 0 && errno == EINTR) {

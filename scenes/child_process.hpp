@@ -1,6 +1,7 @@
-// A helper program started by conform (Xvfb, f3d) as its child: killed by the kernel if conform
-// dies first (PR_SET_PDEATHSIG), so no helper outlives a killed run, and reaped by wait() or
-// stop().
+// A helper program started by conform (Xvfb, f3d, gnuplot, ffmpeg) as its child, from an
+// argument vector (no shell): killed by the kernel if conform dies first (PR_SET_PDEATHSIG), so
+// no helper outlives a killed run, stopped by a stop signal (interrupt.hpp), and reaped by
+// wait() or stop().
 #pragma once
 
 #include <sys/types.h>
@@ -14,6 +15,7 @@ struct ChildOptions {
   std::vector<std::string> env;  // "NAME=value" entries added to (or replacing in) conform's own
   std::string log;               // stdout and stderr go here; "" for /dev/null
   int keep_fd = -1;              // a descriptor the child inherits (e.g. Xvfb's -displayfd)
+  std::string dir;               // its working directory; "" for conform's
 };
 
 class ChildProcess {

@@ -3,7 +3,10 @@
 // world-space) positions, and write every resulting piece as PLY (or OBJ) into DIR with a
 // summary.json of counts and timings. A posed edit also writes the pieces at rest into DIR/rest/
 // (new vertices get the same combination of rest positions as of posed ones). DIR is written
-// atomically (output_folder.hpp): it holds exactly this run's files, or the earlier ones.
+// atomically (output_folder.hpp): it holds exactly this run's files, or the earlier ones. DIR
+// must not be the current folder, hold the model or the scalpel file, or be a folder of other
+// files (exit 2). A stop signal while the pieces are written leaves the earlier ones (exit
+// 128 + the signal).
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -21,6 +24,7 @@
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/tear.hpp"
+#include "interrupt.hpp"
 #include "model_pose.hpp"
 #include "output_folder.hpp"
 
@@ -44,6 +48,7 @@ struct Common {
   double time = 0;
   bool posed = false;  // --time given
   io::IsolationLimits import_limits;
+  std::vector<fs::path> inputs;  // files read besides the model (the scalpel)
 };
 
 void add_common(CLI::App* cmd, Common& c) {
@@ -87,8 +92,16 @@ double rest_area(const mesh::SkinnedMesh& m, const std::vector<std::int32_t>& fa
   return area;
 }
 
+// The files the command reads: --out must not replace the folder of any of them.
+std::vector<fs::path> inputs(const Common& c) {
+  std::vector<fs::path> all = c.inputs;
+  all.emplace_back(c.model);
+  return all;
+}
+
 // Loads the model; returns its mesh (current = the bind pose in world space).
 mesh::SkinnedMesh load(const Common& c, nlohmann::json& summary) {
+  scenes::check_output_folder(c.out, inputs(c));  // refused before the long work
   const auto t0 = Clock::now();
   io::ImportOptions options;
   options.strict_weights = c.strict_weights;
@@ -120,6 +133,7 @@ nlohmann::json write_piece_files(const fs::path& dir, const mesh::SkinnedMesh& m
     char name[32];
     std::snprintf(name, sizeof name, "piece_%03d%s", p, io::mesh_format_extension(format));
     const auto& pf = faces[static_cast<std::size_t>(p)];
+    scenes::check_interrupt();
     io::write_mesh(dir / name, m, {format, rest, true}, pf);
     list.push_back({{"file", name},
                     {"vertices", used_vertex_count(m, pf)},
@@ -133,7 +147,8 @@ nlohmann::json write_piece_files(const fs::path& dir, const mesh::SkinnedMesh& m
 // are in the directory afterwards.
 void write_pieces(const Common& c, const mesh::SkinnedMesh& m, nlohmann::json& summary) {
   const auto t0 = Clock::now();
-  scenes::OutputFolder folder{fs::path(c.out)};
+  const scenes::StopOnSignals stop;
+  scenes::OutputFolder folder{fs::path(c.out), inputs(c)};
   const io::MeshFormat format = io::parse_mesh_format(c.format);
   const mesh::Pieces pieces = mesh::label_pieces(m);
   const nlohmann::json list = write_piece_files(folder.staging(), m, pieces, format, false);
@@ -159,6 +174,7 @@ void write_pieces(const Common& c, const mesh::SkinnedMesh& m, nlohmann::json& s
   os << summary.dump(2) << "\n";
   os.close();
   if (!os) throw std::runtime_error("cannot write " + (fs::path(c.out) / "summary.json").string());
+  scenes::check_interrupt();
   folder.commit();
 }
 
@@ -167,6 +183,13 @@ void run(Context& context, const char* name, Fn fn) {
   try {
     fn();
     context.exit_code = 0;
+  } catch (const scenes::Interrupted& stop) {
+    std::cerr << "conform " << name << ": stopped by " << scenes::signal_name(stop.signal)
+              << "; the earlier results are untouched\n";
+    context.exit_code = stop.exit_code();
+  } catch (const scenes::OutputRefused& e) {
+    std::cerr << "conform " << name << ": " << e.what() << "\n";
+    context.exit_code = 2;
   } catch (const std::exception& e) {
     std::cerr << "conform " << name << ": " << e.what() << "\n";
     context.exit_code = 1;
@@ -298,6 +321,7 @@ void register_tear(CLI::App& app, Context& context) {
       nlohmann::json summary;
       summary["command"] = "tear";
       const auto samples = read_scalpel(*scalpel);
+      common->inputs = {*scalpel};
       mesh::SkinnedMesh m = load(*common, summary);
       const auto t0 = Clock::now();
       mesh::Adjacency adjacency(m);

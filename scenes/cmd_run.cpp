@@ -2,6 +2,9 @@
 // SCENE is a built-in scene name or a JSON scene file. The scene is parsed completely before
 // anything is written, so a bad key or value leaves no folder behind; the results are written
 // atomically (output_folder.hpp): a failed run leaves the earlier results in --out untouched.
+// SIGINT, SIGTERM and SIGHUP stop a run (interrupt.hpp): its helpers and staging folder go, the
+// earlier results stay, and it exits 128 + the signal. A run whose plots, pictures or video
+// could not all be made is put in place with its failures in summary.json, and exits 1.
 #include <omp.h>
 
 #include <fstream>
@@ -10,6 +13,7 @@
 #include <memory>
 
 #include "commands.hpp"
+#include "interrupt.hpp"
 #include "output_folder.hpp"
 #include "scene.hpp"
 
@@ -33,6 +37,16 @@ void print_metrics(const scenes::Json& j, const std::string& prefix) {
   }
 }
 
+// Every "file" the scene reads (e.g. model.file), and the scene file itself: the results must
+// not replace the folder of any of them.
+void collect_inputs(const scenes::Json& j, std::vector<std::filesystem::path>& out) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (j.is_object() && it.key() == "file" && it->is_string())
+      out.emplace_back(it->get<std::string>());
+    if (it->is_structured()) collect_inputs(*it, out);
+  }
+}
+
 }  // namespace
 
 const char* default_scene() {
@@ -52,6 +66,7 @@ int run_scene(const std::string& scene, const std::string& out_dir, int steps,
     std::cerr << "conform run: " << e.what() << " (nothing written)\n";
     return 2;
   }
+  std::vector<std::string> failures;
   const std::filesystem::path dir = out_dir.empty()
                                         ? std::filesystem::path("results") / prepared->common().name
                                         : std::filesystem::path(out_dir);
@@ -61,12 +76,18 @@ int run_scene(const std::string& scene, const std::string& out_dir, int steps,
               << c.dt << " s, seed " << c.seed << "\n"
               << std::flush;
     if (c.threads > 0) omp_set_num_threads(c.threads);
-    scenes::OutputFolder folder(dir);
+    std::vector<std::filesystem::path> inputs;
+    if (!scenes::find_builtin(scene)) inputs.emplace_back(scene);
+    collect_inputs(prepared->resolved(), inputs);
+    const scenes::StopOnSignals stop;
+    scenes::OutputFolder folder(dir, inputs);
     scenes::Json metrics;
     {
       scenes::RunOutput out(folder.staging(), c);
       metrics = prepared->run(out);
+      failures = out.failures();
     }
+    scenes::check_interrupt();  // a signal after the last check still keeps the earlier results
     folder.commit();
     const scenes::Json summary =
         scenes::Json::parse(std::ifstream(dir / "summary.json"), nullptr, false);
@@ -89,7 +110,23 @@ int run_scene(const std::string& scene, const std::string& out_dir, int steps,
                       ? ", pictures/*.png"
                       : "")
               << ")\n";
+    if (!failures.empty()) {
+      std::cerr << "conform run: " << prepared->common().name << ": the run is incomplete ("
+                << failures.size() << " failure" << (failures.size() > 1 ? "s" : "")
+                << ", listed in summary.json):\n";
+      for (const auto& f : failures) std::cerr << "  " << f << "\n";
+      return 1;
+    }
     return 0;
+  } catch (const scenes::Interrupted& stop) {
+    std::cerr << "conform run: " << prepared->common().name << ": stopped by "
+              << scenes::signal_name(stop.signal)
+              << "; its staging folder removed, the earlier results in " << dir.string()
+              << " untouched\n";
+    return stop.exit_code();
+  } catch (const scenes::OutputRefused& e) {
+    std::cerr << "conform run: " << e.what() << "\n";
+    return 2;
   } catch (const std::exception& e) {
     std::cerr << "conform run: " << prepared->common().name << ": " << e.what() << "\n";
     return 1;

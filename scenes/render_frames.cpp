@@ -1,16 +1,22 @@
 #include "render_frames.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <deque>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 #include <thread>
 
+#include "child_process.hpp"
 #include "colour_scale.hpp"
 #include "event_camera.hpp"
 #include "f3d_render.hpp"
+#include "interrupt.hpp"
 #include "picture_compose.hpp"
 #include "progress.hpp"
 #include "strip_mesh.hpp"
@@ -43,7 +49,16 @@ std::string stem(const std::string& prefix, int step) {
 }  // namespace
 
 bool have_tool(const std::string& tool) {
-  return std::system(("command -v " + tool + " > /dev/null 2>&1").c_str()) == 0;
+  // As execvp searches (ChildProcess): each folder of PATH, an empty entry being the current one.
+  const char* path = std::getenv("PATH");
+  std::stringstream folders(path ? path : "/usr/local/bin:/usr/bin:/bin");
+  std::string folder;
+  while (std::getline(folders, folder, ':')) {
+    const fs::path candidate = (folder.empty() ? fs::path(".") : fs::path(folder)) / tool;
+    std::error_code ec;
+    if (fs::is_regular_file(candidate, ec) && ::access(candidate.c_str(), X_OK) == 0) return true;
+  }
+  return false;
 }
 
 PictureRenderer::PictureRenderer(RenderSettings settings, fs::path dir, std::string title)
@@ -99,37 +114,34 @@ void warn(Json& report, const std::string& message) {
   report["warnings"].push_back(message);
 }
 
-// Writes render.sh: the f3d jobs, as many at once as there are cores (f3d is single-threaded
-// and spends most of its time starting), and as comments the renders that started before their
-// surface existed (`prestarted`). Runs it, when it has jobs, on `display` (":N") when conform
-// has none of its own. Returns the running script (to pclose), or nullptr.
-FILE* launch_panels(const fs::path& pics, const std::vector<std::string>& jobs,
-                    const std::vector<std::string>& prestarted, const std::string& display,
-                    Json& report) {
-  const unsigned cores = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
-  {
-    std::ofstream sh(pics / "render.sh");
-    sh << "#!/bin/sh\n# Drawn by conform: the f3d renders of this run's panels (from the PLY "
-          "inputs, removed once rendered).\ncd \"$(dirname \"$0\")\" || exit 1\n";
-    for (const auto& job : prestarted)
-      sh << "# Started while the scene simulated, reading its surface from a FIFO:\n# " << job
-         << "\n";
-    for (std::size_t i = 0; i < jobs.size(); ++i)
-      // A line on stdout per rendered frame: conform's progress counts them.
-      sh << "{ " << jobs[i] << " && echo rendered; } &\n"
-         << ((i + 1) % cores == 0 || i + 1 == jobs.size() ? "wait\n" : "");
-    if (!sh) {
-      warn(report, "cannot write " + (pics / "render.sh").string());
-      return nullptr;
-    }
-  }
-  if (jobs.empty()) return nullptr;
-  std::string cmd = "sh " + shell_words({(pics / "render.sh").string()});
-  if (!display.empty()) cmd = "DISPLAY=" + shell_words({display}) + " " + cmd;
-  cmd += " 2> " + shell_words({(pics / "render.log").string()});
-  FILE* running = ::popen(cmd.c_str(), "r");
-  if (!running) warn(report, "cannot start the render script " + (pics / "render.sh").string());
-  return running;
+// A run's failure to produce something it promised (a render, a picture, the video): recorded in
+// summary.json, and the run exits 1 (RunOutput::failures).
+void fail(Json& report, const std::string& message) {
+  std::cerr << "conform run: error: " << message << "\n";
+  report["failures"].push_back(message);
+}
+
+// `text` as comment lines of a script, whatever newlines it holds.
+std::string comment(const std::string& text) {
+  std::string out = "# ";
+  for (const char c : text) out += c == '\n' ? std::string("\n# ") : std::string(1, c);
+  return out + "\n";
+}
+
+// Writes render.sh, the record of the f3d renders of this run's panels: conform runs them itself,
+// each from its argument vector. The script repeats them (every word single-quoted) and, as
+// comments, the renders that started before their surface existed (`prestarted`).
+bool write_render_record(const fs::path& pics, const std::vector<std::vector<std::string>>& jobs,
+                         const std::vector<std::string>& names,
+                         const std::vector<std::string>& prestarted) {
+  std::ofstream sh(pics / "render.sh");
+  sh << "#!/bin/sh\n# Drawn by conform: the f3d renders of this run's panels, as conform ran them "
+        "(from the PLY inputs, removed once rendered).\ncd \"$(dirname \"$0\")\" || exit 1\n";
+  for (const auto& job : prestarted)
+    sh << "# Started while the scene simulated, reading its surface from a FIFO:\n" << comment(job);
+  for (std::size_t i = 0; i < jobs.size(); ++i)
+    sh << shell_words(jobs[i]) << " > " << shell_words({names[i] + ".png.log"}) << " 2>&1\n";
+  return bool(sh);
 }
 
 // The f3d renders of a frame, left to right, as paths under pictures/ without extension: one
@@ -166,7 +178,7 @@ bool compose(const fs::path& pics, const std::vector<std::vector<FrameSnapshot>>
                       scale);
     }
   } catch (const std::exception& e) {
-    warn(report, e.what());
+    fail(report, e.what());
     return false;
   }
   return true;
@@ -179,18 +191,27 @@ void make_video(const fs::path& dir, const RenderSettings& r, Json& report) {
   }
   const std::string out = r.video == "mp4" ? "run.mp4" : "run.gif";
   // Two pictures a second; the GIF gets its own palette, the MP4 even sizes for yuv420p.
-  const std::string filter =
-      r.video == "mp4" ? "-vf 'scale=trunc(iw/2)*2:trunc(ih/2)*2' -c:v libx264 -pix_fmt yuv420p"
-                       : "-vf 'split[a][b];[a]palettegen[p];[b][p]paletteuse'";
-  const std::string cmd = "cd " + shell_words({dir.string()}) +
-                          " && ffmpeg -y -loglevel error -framerate 2 -pattern_type glob -i "
-                          "'pictures/step_*.png' " +
-                          filter + " " + out + " > pictures/video.log 2>&1";
-  if (std::system(cmd.c_str()) != 0) {
-    warn(report, "ffmpeg failed (see " + (dir / "pictures/video.log").string() + ")");
+  std::vector<std::string> args = {
+      "ffmpeg", "-y", "-loglevel",          "error", "-framerate", "2", "-pattern_type",
+      "glob",   "-i", "pictures/step_*.png"};
+  if (r.video == "mp4")
+    args.insert(args.end(), {"-vf", "scale=trunc(iw/2)*2:trunc(ih/2)*2", "-c:v", "libx264",
+                             "-pix_fmt", "yuv420p"});
+  else
+    args.insert(args.end(), {"-vf", "split[a][b];[a]palettegen[p];[b][p]paletteuse"});
+  args.push_back(out);
+  const fs::path log = fs::absolute(dir / "pictures" / "video.log");
+  ChildOptions options;
+  options.log = log.string();
+  options.dir = fs::absolute(dir).string();
+  ChildProcess ffmpeg(args, options);
+  const int status = ffmpeg.running() ? ffmpeg.wait() : -1;
+  check_interrupt();
+  if (status != 0 || !fs::exists(dir / out)) {
+    fail(report, "ffmpeg failed (exit " + std::to_string(status) + ", see " + log.string() + ")");
     return;
   }
-  fs::remove(dir / "pictures/video.log");
+  fs::remove(log);
   report["video"] = out;
 }
 
@@ -206,7 +227,8 @@ Json camera_json(const Camera& c) {
 }  // namespace
 
 struct PictureRenderer::Pending {
-  Json report = {{"pictures", Json::array()}, {"warnings", Json::array()}};
+  Json report = {
+      {"pictures", Json::array()}, {"warnings", Json::array()}, {"failures", Json::array()}};
   Clock::time_point t0 = Clock::now(), t_render = Clock::now();
   std::vector<std::vector<FrameSnapshot>> frames;
   ColourScale scale{};
@@ -216,7 +238,14 @@ struct PictureRenderer::Pending {
   std::vector<fs::path> inputs;                                // the PLY files render.sh reads
   std::vector<std::pair<PrestartedRender*, std::string>> fed;  // and the render each makes
   std::size_t panels = 0;
-  FILE* running = nullptr;
+  // The f3d renders run from here, at most `cores` at once (f3d is single-threaded and spends
+  // most of its time starting), started by this thread (their parent-death signal follows it).
+  std::vector<std::vector<std::string>> jobs;  // arguments, in pictures/
+  std::vector<std::string> job_names;          // the render each makes
+  std::size_t next_job = 0;
+  std::deque<ChildProcess> running;
+  std::string display;  // ":N" when conform has no display of its own
+  std::size_t cores = 1;
 };
 
 // One f3d render's surface: a frame's panels, or one of them, in its camera's view frame.
@@ -229,7 +258,18 @@ struct PictureRenderer::Input {
 };
 
 PictureRenderer::~PictureRenderer() {
-  if (pending_ && pending_->running) ::pclose(pending_->running);
+  pending_.reset();  // its renders stop before the display they draw on
+}
+
+void PictureRenderer::launch_renders(Pending& p) {
+  while (p.running.size() < p.cores && p.next_job < p.jobs.size()) {
+    const std::size_t k = p.next_job++;
+    ChildOptions options;
+    if (!p.display.empty()) options.env.push_back("DISPLAY=" + p.display);
+    options.log = fs::absolute(p.pics / (p.job_names[k] + ".png.log")).string();
+    options.dir = fs::absolute(p.pics).string();
+    p.running.emplace_back(p.jobs[k], options);
+  }
 }
 
 // Every render's surface: one strip per frame (strip_camera), or one per panel through the
@@ -283,7 +323,7 @@ void PictureRenderer::start() {
     }
   }
   p.t_render = Clock::now();
-  std::vector<std::string> jobs, comments;
+  std::vector<std::string> comments;
   std::size_t last = 0;  // the last frame's renders so far
   for (const auto& in : inputs(p)) {
     if (in.last && feed_prestarted(last++, in, p)) {
@@ -293,11 +333,15 @@ void PictureRenderer::start() {
     const fs::path ply = p.pics / (in.name + ".ply");
     std::ofstream(ply, std::ios::binary) << in.ply;
     p.inputs.push_back(ply);
-    jobs.push_back(shell_words(f3d_arguments(in.name + ".ply", in.name + ".png", in.width,
-                                             settings_.height, in.view_angle)) +
-                   " > " + shell_words({in.name + ".png.log"}) + " 2>&1");
+    p.jobs.push_back(f3d_arguments(in.name + ".ply", in.name + ".png", in.width, settings_.height,
+                                   in.view_angle));
+    p.job_names.push_back(in.name);
   }
-  p.running = launch_panels(p.pics, jobs, comments, display, p.report);
+  if (!write_render_record(p.pics, p.jobs, p.job_names, comments))
+    fail(p.report, "cannot write " + (p.pics / "render.sh").string());
+  p.display = display;
+  p.cores = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
+  launch_renders(p);
 }
 
 // Hands render `in`, the k-th of the last frame, to the f3d started for it, when that one
@@ -319,40 +363,49 @@ bool PictureRenderer::feed_prestarted(std::size_t k, const Input& in, Pending& p
 
 Json PictureRenderer::finish() {
   if (!started_) start();
+  check_interrupt();
   Pending& p = *pending_;
   Json& report = p.report;
-  if (!p.running && p.fed.empty()) return report;
+  if (p.jobs.empty() && p.fed.empty()) return report;
   Progress bar("pictures", "render", long(jobs_count(p.frames, settings_.perspective)));
   long rendered = 0;
   for (const auto& [render, name] : p.fed) {
     std::string problem;
-    if (render->finish(problem))
+    const bool ok = render->finish(problem);
+    check_interrupt();
+    if (ok)
       fs::rename(render->png(), p.pics / (name + ".png"));
     else
-      warn(report, problem);
+      warn(report, problem);  // why: its render is missing, a failure below
     bar.update(++rendered);
   }
-  char line[64];
-  while (p.running && std::fgets(line, sizeof line, p.running)) bar.update(++rendered);
-  if (p.running && ::pclose(p.running) != 0)
-    warn(report, "the render script failed (see " + (p.pics / "render.log").string() + ")");
-  p.running = nullptr;
+  while (!p.running.empty()) {
+    const int status = p.running.front().wait();
+    check_interrupt();
+    p.running.pop_front();
+    if (status == 0) bar.update(++rendered);
+    launch_renders(p);
+  }
   bar.finish();
   const double render_ms = ms_since(p.t_render);
   for (const auto& in : p.inputs) fs::remove(in);
   std::size_t missing = 0;
+  std::string first_missing;
   for (const auto& f : p.frames)
     for (const auto& name : renders_of(f, settings_.perspective)) {
       const fs::path png = p.pics / (name + ".png");
-      if (!fs::exists(png)) ++missing;
-      fs::remove(png.string() + ".log");
+      if (fs::exists(png)) {
+        fs::remove(png.string() + ".log");
+      } else if (missing++ == 0) {
+        first_missing = png.string() + ".log";
+      }
     }
   if (missing > 0) {
-    warn(report, std::to_string(missing) + " renders are missing (see " +
-                     (p.pics / "render.log").string() + ")");
+    fail(report, std::to_string(missing) + " of " +
+                     std::to_string(jobs_count(p.frames, settings_.perspective)) +
+                     " renders are missing (see " + first_missing + ")");
     return report;
   }
-  fs::remove(p.pics / "render.log");
   const auto t_compose = Clock::now();
   if (compose(p.pics, p.frames, settings_, p.scale, title_, report))
     for (const auto& f : p.frames)

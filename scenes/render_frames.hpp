@@ -11,10 +11,13 @@
 //   pictures/step_STEP.png        the side-by-side picture of one frame
 //   pictures/panels/strip_STEP.png the frame's panels side by side as f3d rendered them
 //                                 (NAME_STEP.png, one per panel, with render.perspective)
-//   pictures/render.sh            the f3d commands that made the panels, for the record (their
-//                                 PLY inputs are removed once rendered)
+//   pictures/render.sh            the f3d commands that made the panels, for the record: conform
+//                                 runs f3d itself, from argument vectors (their PLY inputs are
+//                                 removed once rendered)
 //   run.gif or run.mp4            the pictures in turn (when there are 2 or more)
-// A missing tool (f3d, Xvfb, ffmpeg) is a warning, never a failed run.
+// A missing tool (f3d, Xvfb, ffmpeg) is a warning, never a failed run; a render, picture or video
+// that a present tool failed to make is a failure of the run (the report's "failures").
+// No helper is run through a shell. A stop signal (interrupt.hpp) ends the renders and throws.
 #pragma once
 
 #include <filesystem>
@@ -56,6 +59,7 @@ class PictureRenderer {
   struct Input;    // one render's surface
   std::vector<Input> inputs(const Pending& p) const;
   bool feed_prestarted(std::size_t k, const Input& in, Pending& p);
+  static void launch_renders(Pending& p);
 
   RenderSettings settings_;
   std::filesystem::path dir_;
@@ -68,7 +72,7 @@ class PictureRenderer {
   bool started_ = false;
 };
 
-/// True when `tool` is on PATH.
+/// True when `tool` is an executable file in a folder of PATH (searched here, not by a shell).
 bool have_tool(const std::string& tool);
 
 }  // namespace conform::scenes

@@ -8,10 +8,12 @@
 #include <ctime>
 #include <iostream>
 
+#include "child_process.hpp"
 #include "conform/bullet/convert.hpp"
 #include "conform/io/mesh_export.hpp"
 #include "conform/version.hpp"
 #include "gltf_sequence.hpp"
+#include "interrupt.hpp"
 #include "render_frames.hpp"
 
 namespace conform::scenes {
@@ -143,19 +145,23 @@ Json RunOutput::finish_render(Clock::time_point t0, double plots_ms, double loop
 }
 
 void RunOutput::progress(int step, int steps) {
+  check_interrupt();  // every scene reports each step: where a stop signal ends the loop
   if (!progress_) progress_ = std::make_unique<Progress>(common_.name, "step", steps);
   progress_->update(step);
 }
 
 namespace {
 
+// A gnuplot string constant holding `s` as it is: single-quoted, where gnuplot substitutes no
+// backquoted command and no escape (a quote is doubled). A line break would end the command:
+// it becomes a space.
 std::string quote(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
+  std::string out = "'";
+  for (const char c : s) {
+    if (c == '\'') out += '\'';
+    out += c == '\n' || c == '\r' ? ' ' : c;
   }
-  return out + "\"";
+  return out + "'";
 }
 
 void write_axes(std::ostream& gp, const Plot& p) {
@@ -206,20 +212,23 @@ bool write_plot_script(const fs::path& dir, const Plot& plot, std::string& probl
 
 std::vector<std::string> draw_plots(const fs::path& dir, const std::vector<Plot>& plots) {
   std::vector<std::string> problems(plots.size());
-  std::string scripts;
+  std::vector<std::string> args = {"gnuplot"};
   for (std::size_t i = 0; i < plots.size(); ++i)
-    if (write_plot_script(dir, plots[i], problems[i]))
-      scripts += " " + quote(plots[i].name + ".gp");
-  if (scripts.empty()) return problems;
+    if (write_plot_script(dir, plots[i], problems[i])) args.push_back(plots[i].name + ".gp");
+  if (args.size() == 1) return problems;
   // One gnuplot for all: its start-up (fonts, cairo) is most of a small plot's cost.
-  const std::string cmd =
-      "cd " + quote(dir.string()) + " && gnuplot" + scripts + " > plots.log 2>&1";
-  const bool ok = std::system(cmd.c_str()) == 0;
+  const fs::path log = fs::absolute(dir / "plots.log");
+  ChildOptions options;
+  options.log = log.string();
+  options.dir = fs::absolute(dir).string();
+  ChildProcess gnuplot(args, options);
+  const bool ok = gnuplot.running() && gnuplot.wait() == 0;
+  check_interrupt();
   // gnuplot stops at the first failing script: what came before it was drawn.
   for (std::size_t i = 0; i < plots.size(); ++i)
     if (problems[i].empty() && (!ok || !fs::exists(dir / (plots[i].name + ".png"))))
       problems[i] = "gnuplot failed (see plots.log in the output folder)";
-  if (ok) fs::remove(dir / "plots.log");
+  if (ok) fs::remove(log);
   return problems;
 }
 
@@ -251,6 +260,7 @@ std::string first_non_finite(const Json& value, const std::string& key) {
 fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int steps,
                            double simulated_seconds, double loop_seconds) {
   metrics_.reset();  // flush metrics.csv before gnuplot reads it
+  check_interrupt();
   if (progress_) progress_->finish();
   if (const std::string bad = first_non_finite(metrics, ""); !bad.empty())
     throw std::runtime_error("metric " + bad +
@@ -263,14 +273,20 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   if (common_.plots) {
     std::vector<std::string> problems(
         plots_.size(), "gnuplot is not installed (scripts/deps.sh installs gnuplot-nox)");
-    if (have_gnuplot()) problems = draw_plots(dir_, plots_);
-    for (std::size_t i = 0; i < plots_.size(); ++i)
+    const bool drawn = have_gnuplot();
+    if (drawn) problems = draw_plots(dir_, plots_);
+    for (std::size_t i = 0; i < plots_.size(); ++i) {
       plots[plots_[i].name] =
           problems[i].empty() ? plots_[i].name + ".png" : "not drawn: " + problems[i];
+      // A missing gnuplot is a note; a gnuplot that failed, a failure of the run.
+      if (drawn && !problems[i].empty())
+        failures_.push_back("plot " + plots_[i].name + " not drawn: " + problems[i]);
+    }
   }
   const double plots_ms =
       std::chrono::duration<double, std::milli>(Clock::now() - plots_start).count();
   const Json render = finish_render(render_start, plots_ms, loop_seconds, steps);
+  for (const auto& f : render.value("failures", Json::array())) failures_.push_back(f);
   const double wall = std::chrono::duration<double>(Clock::now() - start_).count();
   Json summary;
   summary["scene"] = common_.name;
@@ -299,6 +315,7 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   summary["frames"] = frames_;
   summary["plots"] = plots;
   summary["render"] = render;
+  summary["failures"] = failures_;
   const fs::path path = dir_ / "summary.json", tmp = dir_ / ".summary.json.tmp";
   {
     std::ofstream out(tmp);

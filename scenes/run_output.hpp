@@ -115,6 +115,9 @@ class RunOutput {
   /// per simulated second and per step (of the stepping loop, `loop_seconds` long) are added.
   std::filesystem::path finish(const Json& settings, Json metrics, Json timings, int steps,
                                double simulated_seconds, double loop_seconds);
+  /// What finish() did not produce that the run promised (a plot gnuplot failed to draw, a
+  /// render, picture or video): summary.json's "failures"; the run then exits 1.
+  const std::vector<std::string>& failures() const { return failures_; }
 
  private:
   /// The pictures (started at t0, while plots took plots_ms), the video and run.glb; their
@@ -131,11 +134,14 @@ class RunOutput {
   std::unique_ptr<GltfSequence> gltf_;
   int frames_ = 0;
   std::unique_ptr<Progress> progress_;
+  std::vector<std::string> failures_;
 };
 
 /// Draws each plot into dir/NAME.png (its script kept as dir/NAME.gp; series files relative to
 /// `dir`), all in one gnuplot process; returns each plot's problem ("" when drawn). RunOutput
-/// and `conform sweep` draw through this one function.
+/// and `conform sweep` draw through this one function. Every title, label and file name is a
+/// single-quoted gnuplot string (no backquote substitution), and gnuplot is run from its
+/// argument vector, not through a shell.
 std::vector<std::string> draw_plots(const std::filesystem::path& dir,
                                     const std::vector<Plot>& plots);
 /// Whether gnuplot is on the PATH.

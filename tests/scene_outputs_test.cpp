@@ -38,10 +38,12 @@ std::string read(const fs::path& file) {
   return {std::istreambuf_iterator<char>(in), {}};
 }
 
-// Nothing but `target` and its lock (and the logs of this test) beside it: no staging folder.
+// Nothing but `target` (and the logs of this test) beside it: no staging folder, and no lock
+// (a run removes its lock file when it ends).
 void expect_no_staging(const fs::path& target) {
   for (const auto& e : fs::directory_iterator(target.parent_path()))
     EXPECT_EQ(e.path().filename().string().find(".staging-"), std::string::npos) << e.path();
+  EXPECT_FALSE(fs::exists(target.parent_path() / ("." + target.filename().string() + ".lock")));
 }
 
 fs::path fresh(const std::string& tag) {
@@ -73,13 +75,28 @@ TEST(SceneOutputs, FailedRunLeavesEarlierResultsUntouched) {
 
 TEST(SceneOutputs, ReusedFolderHoldsOnlyTheNewRun) {
   const fs::path out = fresh("reused");
-  fs::create_directories(out / "frames");
+  ASSERT_EQ(conform_run(kShortRun, out).rc, 0);
+  EXPECT_TRUE(fs::exists(out / ".conform-run"));  // an earlier result: the next run replaces it
   std::ofstream(out / "frames" / "stale_000001.ply") << "ply\n";
   std::ofstream(out / "stale.csv") << "x\n1\n";
   ASSERT_EQ(conform_run(kShortRun, out).rc, 0);
   EXPECT_FALSE(fs::exists(out / "frames" / "stale_000001.ply"));
   EXPECT_FALSE(fs::exists(out / "stale.csv"));
   EXPECT_TRUE(fs::exists(out / "summary.json"));
+  expect_no_staging(out);
+}
+
+// A folder of other files is the user's: refused with exit 2, every file kept.
+TEST(SceneOutputs, FolderOfOtherFilesIsRefused) {
+  const fs::path out = fresh("foreign");
+  fs::create_directories(out);
+  std::ofstream(out / "thesis.tex") << "mine\n";
+  const Result r = conform_run(kShortRun, out);
+  EXPECT_EQ(r.rc, 2) << r.log;
+  EXPECT_NE(r.log.find("not an earlier Conform result"), std::string::npos) << r.log;
+  EXPECT_EQ(read(out / "thesis.tex"), "mine\n");
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+  EXPECT_FALSE(fs::exists(out.parent_path() / ".out.lock"));
   expect_no_staging(out);
 }
 

@@ -133,7 +133,7 @@ TEST_F(SceneRender, RunSucceedsAndReportsItsRenders) {
   EXPECT_GT(r["render_ms_per_picture"].get<double>(), 0);
   EXPECT_GT(r["sim_ms_per_step"].get<double>(), 0);
   // The last frame's f3d started with the first frame (f3d_render.hpp); the other frame's ran
-  // from render.sh.
+  // from conform's own f3d jobs (recorded in render.sh).
   EXPECT_EQ(r["timings"]["f3d_started_early"], 1);
   EXPECT_FALSE(r.contains("notes")) << r["notes"].dump();
 }

@@ -60,7 +60,7 @@ for m in rms_error max_error; do
   done
 done
 # One line per value of the other key.
-[[ $(grep -c '^     "data/\|^plot "data/' "$tmp/grid/plots/rms_error_vs_physics_substeps.gp") -eq 2 ]] ||
+[[ $(grep -c "^     'data/\|^plot 'data/" "$tmp/grid/plots/rms_error_vs_physics_substeps.gp") -eq 2 ]] ||
   fail "rms_error vs substeps should have 2 lines (one per arm.kp)"
 grep -q 'arm.kp = 0.3' "$tmp/grid/plots/rms_error_vs_physics_substeps.gp" || fail "no legend per line"
 
