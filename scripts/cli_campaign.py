@@ -22,7 +22,8 @@ After each run it checks, and counts as a defect:
             environment tag that every child inherits)
   staging   a .NAME.staging-PID folder or .NAME.lock file is left behind
   mismatch  the exit code does not match the outcome: 0 without a complete result (or with a
-            non-finite number in it), a failure that changed the earlier result, a signalled
+            non-finite number in it), a failure that changed the earlier result (unless it
+            was swapped in as incomplete, exit 1, with its failures in summary.json), a signalled
             run that did not exit with 128 + signal (or 0, when it finished first)
   hang      still running after --limit seconds (killed)
   memory    peak resident memory above --max-rss-mb on a non-model input
@@ -361,6 +362,15 @@ def result_complete(trial, folder):
     return bool(names)
 
 
+def recorded_failure(folder):
+    """Whether `folder` is a run swapped in as incomplete: its summary lists its failures."""
+    try:
+        with open(os.path.join(folder, "summary.json")) as f:
+            return bool(json.load(f).get("failures"))
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 def finite_json(text):
     try:
         json.loads(text, parse_constant=lambda c: (_ for _ in ()).throw(ValueError(c)))
@@ -452,7 +462,8 @@ def exit_mismatches(trial, results, before, after, out, may):
             defects.append("mismatch")
         elif not sig and rc >= 128:
             defects.append("mismatch")  # a crash
-    if out is not None and all(r[0] not in (0, None) for r in results):
+    if out is not None and all(r[0] not in (0, None) for r in results) and not (
+            1 in [r[0] for r in results] and recorded_failure(out)):
         earlier = {p: v for p, v in before.items() if inside(p, out)}
         now = {p: v for p, v in after.items() if inside(p, out)}
         if earlier != now:
