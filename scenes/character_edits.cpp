@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "conform/skin/pose.hpp"
+#include "event_time.hpp"
 
 namespace conform::scenes {
 
@@ -138,7 +139,7 @@ Json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, const CutEdi
 }
 
 void TearRun::advance(bullet::SkinnedSoftBody& body, double t) {
-  for (; next_ < edit_.samples && edit_.time(next_) <= t + 1e-12; ++next_) {
+  for (; next_ < edit_.samples && event_due(t, edit_.time(next_)); ++next_) {
     const double u = edit_.samples > 1 ? double(next_) / (edit_.samples - 1) : 0.0;
     const Vec3 p = bind_.point((1 - u) * edit_.from + u * edit_.to);
     const BoneCarrier carrier(body, bind_, edit_.bone, bind_.point(edit_.from), "tear.bone");

@@ -7,14 +7,20 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <utility>
 #include <vector>
 
 #include "commands.hpp"
 #include "conform/ik/arm_ik.hpp"
+#include "finite_json.hpp"
 
 namespace conform::cli {
 
 namespace {
+
+// Arm segment lengths, m: below a micrometre (denormals passed as "positive") or above a
+// thousand kilometres the solve loses all precision or overflows.
+constexpr double kMinLength = 1e-6, kMaxLength = 1e6;
 
 struct IkOptions {
   std::vector<double> target;
@@ -30,10 +36,12 @@ int run_ik(const IkOptions& o) {
     std::cerr << "conform ik: --target needs three finite numbers X Y Z\n";
     return 2;
   }
-  if (!(std::isfinite(o.upper) && o.upper > 0 && std::isfinite(o.fore) && o.fore > 0)) {
-    std::cerr << "conform ik: --upper and --fore must be positive finite lengths\n";
-    return 2;
-  }
+  for (const auto& [name, length] : {std::pair{"--upper", o.upper}, std::pair{"--fore", o.fore}})
+    if (!(length >= kMinLength && length <= kMaxLength)) {
+      std::cerr << "conform ik: " << name << " " << length << " must be a length in [" << kMinLength
+                << ", " << kMaxLength << "] m\n";
+      return 2;
+    }
   if (!std::isfinite(o.swivel) || std::abs(o.swivel) > ik::kMaxSwivel) {
     std::cerr << "conform ik: --swivel must be a finite angle in radians, |PHI| <= "
               << ik::kMaxSwivel << "\n";
@@ -57,13 +65,21 @@ int run_ik(const IkOptions& o) {
   const auto quat = [](const Eigen::Quaterniond& q) {
     return std::vector<double>{q.w() + 0.0, q.x() + 0.0, q.y() + 0.0, q.z() + 0.0};  // no −0
   };
+  nlohmann::json j;
+  j["qs"] = quat(s.qs);
+  j["qe"] = quat(s.qe);
+  j["elbow"] = {s.elbow.x() + 0.0, s.elbow.y() + 0.0, s.elbow.z() + 0.0};
+  j["wrist"] = {fk.wrist.x(), fk.wrist.y(), fk.wrist.z()};
+  j["status"] = ik::to_string(s.status);
+  j["wrist_error"] = wrist_error;
+  // Finite or refused, in both forms of the output.
+  if (const std::string bad = scenes::first_non_finite(j); !bad.empty()) {
+    std::cerr << "conform ik: the solution's " << bad << " is not finite (the lengths or the "
+              << "target are too large for double precision); nothing printed\n";
+    return 1;
+  }
   if (o.json) {
-    nlohmann::json j;
-    j["qs"] = quat(s.qs);
-    j["qe"] = quat(s.qe);
-    j["elbow"] = {s.elbow.x() + 0.0, s.elbow.y() + 0.0, s.elbow.z() + 0.0};
-    j["status"] = ik::to_string(s.status);
-    j["wrist_error"] = wrist_error;
+    j.erase("wrist");
     std::cout << j.dump() << "\n";
     return 0;
   }
@@ -95,8 +111,10 @@ void register_ik(CLI::App& app, Context& context) {
   cmd->add_option("--swivel", opts->swivel,
                   "Swivel angle PHI [rad] about the shoulder-wrist line (0: elbow towards +z)")
       ->capture_default_str();
-  cmd->add_option("--upper", opts->upper, "Upper arm length D1 [m]")->capture_default_str();
-  cmd->add_option("--fore", opts->fore, "Forearm length D2 [m]")->capture_default_str();
+  cmd->add_option("--upper", opts->upper, "Upper arm length D1 [m], in [1e-6, 1e6]")
+      ->capture_default_str();
+  cmd->add_option("--fore", opts->fore, "Forearm length D2 [m], in [1e-6, 1e6]")
+      ->capture_default_str();
   cmd->add_flag("--json", opts->json, "Print one JSON object: qs, qe, elbow, status, wrist_error");
   cmd->callback([opts, &context]() { context.exit_code = run_ik(*opts); });
 }

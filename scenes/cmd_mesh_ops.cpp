@@ -25,8 +25,10 @@
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/tear.hpp"
 #include "interrupt.hpp"
+#include "finite_json.hpp"
 #include "model_pose.hpp"
 #include "output_folder.hpp"
+#include "scalpel_csv.hpp"
 
 namespace conform::cli {
 
@@ -170,6 +172,7 @@ void write_pieces(const Common& c, const mesh::SkinnedMesh& m, nlohmann::json& s
                        {"manifold", report.manifold()},
                        {"oriented", report.oriented()}};
   summary["timing_ms"]["write"] = ms_since(t0);
+  scenes::require_finite(summary, "summary.json");
   std::ofstream os(folder.staging() / "summary.json");
   os << summary.dump(2) << "\n";
   os.close();
@@ -196,39 +199,19 @@ void run(Context& context, const char* name, Fn fn) {
   }
 }
 
-// Reads the scalpel CSV: header t,ax,ay,az,bx,by,bz, then one sample per line.
-std::vector<mesh::ScalpelSample> read_scalpel(const std::string& file) {
-  std::ifstream is(file);
-  if (!is) throw std::runtime_error("cannot open scalpel file " + file);
-  std::string line;
-  if (!std::getline(is, line)) throw std::runtime_error(file + ": empty scalpel file");
-  std::string header;
-  for (char ch : line)
-    if (!std::isspace(static_cast<unsigned char>(ch))) header += ch;
-  if (header != "t,ax,ay,az,bx,by,bz")
-    throw std::runtime_error(file + ": the header must be t,ax,ay,az,bx,by,bz");
-  std::vector<mesh::ScalpelSample> out;
-  int row = 1;
-  while (std::getline(is, line)) {
-    ++row;
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    std::stringstream ss(line);
-    double v[7];
-    for (int k = 0; k < 7; ++k) {
-      std::string cell;
-      if (!std::getline(ss, cell, ','))
-        throw std::runtime_error(file + ":" + std::to_string(row) + ": expected 7 values");
-      try {
-        std::size_t used = 0;
-        v[k] = std::stod(cell, &used);
-      } catch (const std::exception&) {
-        throw std::runtime_error(file + ":" + std::to_string(row) + ": not a number: '" + cell +
-                                 "'");
-      }
-    }
-    out.push_back({v[0], {v[1], v[2], v[3]}, {v[4], v[5], v[6]}});
+// The largest --open: the model's bounding-box diagonal (a wider opening moves the borders
+// out of the model; 1e308 wrote vertices at 5e307 and an infinite area).
+void check_opening(double open, const mesh::SkinnedMesh& m) {
+  const double diagonal =
+      m.vertex_count() > 0
+          ? (m.current.rowwise().maxCoeff() - m.current.rowwise().minCoeff()).norm()
+          : 0.0;
+  if (open > diagonal) {
+    std::ostringstream why;
+    why << "--open " << open << " is more than the model's size (its bounding-box diagonal, "
+        << diagonal << ")";
+    throw std::runtime_error(why.str());
   }
-  return out;
 }
 
 }  // namespace
@@ -320,9 +303,10 @@ void register_tear(CLI::App& app, Context& context) {
     run(context, "tear", [&] {
       nlohmann::json summary;
       summary["command"] = "tear";
-      const auto samples = read_scalpel(*scalpel);
+      const auto samples = scenes::read_scalpel_csv(*scalpel);
       common->inputs = {*scalpel};
       mesh::SkinnedMesh m = load(*common, summary);
+      check_opening(*open, m);
       const auto t0 = Clock::now();
       mesh::Adjacency adjacency(m);
       const double t_adj = ms_since(t0);
@@ -338,7 +322,9 @@ void register_tear(CLI::App& app, Context& context) {
           {"steps", tear.steps()}, {"points", tear.path_length()}, {"length", tear.length()}};
       if (!tear.message().empty()) summary["message"] = tear.message();
       if (tear.steps() == 0)
-        throw std::runtime_error("the scalpel never tore the surface: " + tear.message());
+        throw std::runtime_error(
+            "the scalpel never tore the surface: " +
+            (tear.message().empty() ? std::string("no blade crossed it") : tear.message()));
       write_pieces(*common, m, summary);
     });
   });

@@ -6,12 +6,15 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <sstream>
+#include <vector>
 
 #include "commands.hpp"
 #include "conform/io/import.hpp"
 #include "conform/io/mesh_export.hpp"
 #include "conform/skin/skinner.hpp"
 #include "model_pose.hpp"
+#include "output_caps.hpp"
 
 namespace conform::cli {
 namespace {
@@ -22,6 +25,7 @@ struct SkinArgs {
   int frames = 0;
   int max_influences = 4;
   int threads = 0;
+  double max_output_mib = scenes::kDefaultMaxOutputMib;
   bool strict_weights = false;
   io::IsolationLimits import_limits;
 };
@@ -41,10 +45,35 @@ std::filesystem::path frame_path(const std::filesystem::path& out, int frame, in
   return p;
 }
 
+// The frames written so far, removed unless the command completes (a failed pose or a full
+// disk left them behind).
+struct WrittenFrames {
+  std::vector<std::filesystem::path> paths;
+  ~WrittenFrames() {
+    std::error_code ignored;
+    for (const auto& p : paths) std::filesystem::remove(p, ignored);
+  }
+};
+
+// Refuses, before anything is written, an output larger than `max_mib` in all: the size of one
+// frame (encoded from the bind pose; exact for binary PLY, close for text) times the frames.
+void check_output_size(const mesh::SkinnedMesh& mesh, const io::MeshExportOptions& options,
+                       int frames, double max_mib) {
+  const double frame_mib = double(io::mesh_file_size(mesh, options)) / 1048576.0;
+  if (frame_mib * frames > max_mib) {
+    std::ostringstream why;
+    why << frames << " frames of " << frame_mib << " MiB would write " << frame_mib * frames
+        << " MiB, more than --max-output-mib " << max_mib;
+    throw std::invalid_argument(why.str());
+  }
+}
+
 int run_skin(const SkinArgs& a, bool has_time, bool has_frames) {
   if (has_time == has_frames)
     throw std::invalid_argument("give exactly one of --time and --frames");
-  if (has_frames && a.frames < 1) throw std::invalid_argument("--frames must be at least 1");
+  if (has_frames && (a.frames < 1 || a.frames > scenes::kMaxFrames))
+    throw std::invalid_argument("--frames " + std::to_string(a.frames) + " must be in [1, " +
+                                std::to_string(scenes::kMaxFrames) + "]");
   if (a.max_influences < 1 || a.max_influences > 16)
     throw std::invalid_argument("--max-influences must be in [1, 16]");
   skin::Blend blend;
@@ -88,10 +117,12 @@ int run_skin(const SkinArgs& a, bool has_time, bool has_frames) {
   const double setup_ms = ms_since(t0);
 
   const int frames = has_frames ? a.frames : 1;
+  check_output_size(model.mesh, out_options, frames, a.max_output_mib);
   const double duration = anim ? anim->duration() : 0;
   skin::Pose pose = skin::Pose::rest(model.skeleton);
   std::vector<double> skin_ms;
   double write_ms = 0;
+  WrittenFrames written;
   for (int f = 0; f < frames; ++f) {
     const double t = has_time ? a.time : (frames > 1 ? duration * f / (frames - 1) : 0.0);
     const auto ts = Clock::now();
@@ -102,10 +133,12 @@ int run_skin(const SkinArgs& a, bool has_time, bool has_frames) {
     const auto tw = Clock::now();
     const auto path = frame_path(a.out, f, frames);
     io::write_mesh(path, model.mesh, out_options);
+    written.paths.push_back(path);
     write_ms += ms_since(tw);
     if (frames > 1 && (f == 0 || f + 1 == frames))
       std::cout << "  frame " << f << " t=" << t << " s → " << path.string() << "\n";
   }
+  written.paths.clear();  // complete: kept
   std::vector<double> sorted = skin_ms;
   std::sort(sorted.begin(), sorted.end());
   const double median = sorted[sorted.size() / 2];
@@ -134,13 +167,17 @@ void register_skin(CLI::App& app, Context& context) {
       ->required();
   cmd->add_option("--animation", args->animation, "animation name or index (default: the first)");
   auto* time = cmd->add_option("--time", args->time, "time in seconds");
-  auto* frames = cmd->add_option("--frames", args->frames, "N frames evenly over the animation");
+  auto* frames = cmd->add_option("--frames", args->frames,
+                                 "N frames evenly over the animation (at most 10000)");
   time->excludes(frames);
   cmd->add_option("--blend", args->blend, "key interpolation: linear or log (default log)");
   cmd->add_option("--mode", args->mode, "lbs (eq 17) or versor (blend the versors; default lbs)");
   cmd->add_option("--max-influences", args->max_influences,
                   "largest influences used per vertex (default 4)");
   cmd->add_option("--threads", args->threads, "OpenMP threads (default: all)");
+  cmd->add_option("--max-output-mib", args->max_output_mib,
+                  "refuse, before writing, output larger than this in all, MiB (default 4096)")
+      ->check(CLI::PositiveNumber);
   add_strict_weights(cmd, args->strict_weights);
   add_import_limits(cmd, args->import_limits);
   cmd->add_option("--out", args->out, "output .ply or .obj (with --frames: name_0000.ext, ...)")

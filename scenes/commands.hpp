@@ -31,12 +31,16 @@ inline void add_strict_weights(CLI::App* cmd, bool& strict) {
                 "with one warning)");
 }
 
-/// --import-seconds, --import-memory: the caps of the isolated import (io::IsolationLimits) on
-/// every command that loads a model file.
+/// --import-seconds, --import-seconds-per-mib, --import-memory: the caps of the isolated import
+/// (io::IsolationLimits) on every command that loads a model file.
 inline void add_import_limits(CLI::App* cmd, io::IsolationLimits& limits) {
   cmd->add_option("--import-seconds", limits.seconds,
-                  "give up reading the model file after this many seconds (default 30)")
+                  "give up reading the model file after this many seconds plus "
+                  "--import-seconds-per-mib for every MiB of it (default 2)")
       ->check(CLI::Range(0.001, 86400.0));
+  cmd->add_option("--import-seconds-per-mib", limits.seconds_per_mib,
+                  "seconds added to the import's time cap per MiB of the file (default 10)")
+      ->check(CLI::Range(0.0, 86400.0));
   cmd->add_option_function<double>(
          "--import-memory",
          [&limits](double mib) { limits.memory_bytes = static_cast<std::size_t>(mib * 1048576.0); },

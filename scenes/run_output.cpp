@@ -12,8 +12,10 @@
 #include "conform/bullet/convert.hpp"
 #include "conform/io/mesh_export.hpp"
 #include "conform/version.hpp"
+#include "finite_json.hpp"
 #include "gltf_sequence.hpp"
 #include "interrupt.hpp"
+#include "output_caps.hpp"
 #include "render_frames.hpp"
 
 namespace conform::scenes {
@@ -53,6 +55,7 @@ CommonSettings read_common(Reader& root, const std::string& name, double default
                          std::to_string(static_cast<long long>(steps)) +
                          " steps, more than the limit of " + std::to_string(kMaxSteps));
   c.steps = steps_override > 0 ? steps_override : static_cast<int>(steps);
+  check_output_caps(c);
   return c;
 }
 
@@ -236,27 +239,6 @@ bool have_gnuplot() {
   return have_tool("gnuplot");
 }
 
-namespace {
-
-// The key of the first NaN or infinite number in `value` ("" when all are finite). JSON has no
-// NaN: nlohmann would write it as null, and a summary would look like a success.
-std::string first_non_finite(const Json& value, const std::string& key) {
-  if (value.is_number_float() && !std::isfinite(value.get<double>()))
-    return key.empty() ? "(value)" : key;
-  if (value.is_object())
-    for (auto it = value.begin(); it != value.end(); ++it)
-      if (auto bad = first_non_finite(*it, key.empty() ? it.key() : key + "." + it.key());
-          !bad.empty())
-        return bad;
-  if (value.is_array())
-    for (std::size_t i = 0; i < value.size(); ++i)
-      if (auto bad = first_non_finite(value[i], key + "[" + std::to_string(i) + "]"); !bad.empty())
-        return bad;
-  return {};
-}
-
-}  // namespace
-
 fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int steps,
                            double simulated_seconds, double loop_seconds) {
   metrics_.reset();  // flush metrics.csv before gnuplot reads it
@@ -316,6 +298,8 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   summary["plots"] = plots;
   summary["render"] = render;
   summary["failures"] = failures_;
+  // Settings, timings and what the scene added: JSON would hold NaN or inf as null.
+  require_finite(summary, "summary.json");
   const fs::path path = dir_ / "summary.json", tmp = dir_ / ".summary.json.tmp";
   {
     std::ofstream out(tmp);

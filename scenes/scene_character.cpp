@@ -11,6 +11,7 @@
 #include "character_edits.hpp"
 #include "conform/io/import.hpp"
 #include "conform/io/weld_model.hpp"
+#include "event_time.hpp"
 #include "scene.hpp"
 #include "soft_scene.hpp"
 
@@ -108,6 +109,7 @@ class Character final : public Scene {
 
   Json run(RunOutput& out) override {
     CommonSettings c = common_;
+    require_edits_before_end(c);
     io::SkinnedModel model = io::load_model(file_, import_);
     const Eigen::Matrix3Xd file_rest = model.mesh.rest;
     const mesh::WeldResult weld =
@@ -171,16 +173,25 @@ class Character final : public Scene {
   }
 
  private:
+  // Every enabled edit happens before the last step (else it would be skipped unsaid).
+  void require_edits_before_end(const CommonSettings& c) const {
+    if (cut_.enabled) require_before_end(c, "cut.at", cut_.at, "the cut", cut_.at);
+    if (tear_.enabled)
+      require_before_end(c, "tear.at", tear_.at, "the tear's last sample (tear.at + tear.duration)",
+                         tear_.time(tear_.samples - 1));
+    if (drill_.enabled) require_before_end(c, "drill.at", drill_.at, "the drill", drill_.at);
+  }
+
   // The edits due at time t (between steps, at the body's last pose).
   void edit(bullet::SkinnedSoftBody& body, const BindPose& bind, TearRun& tear, double t,
             RunState& s) const {
-    if (cut_.enabled && !s.cut_done && t >= cut_.at - 1e-12) {
+    if (cut_.enabled && !s.cut_done && event_due(t, cut_.at)) {
       s.cut = apply_cut(body, bind, cut_);
       s.cut_done = true;
       if (s.cut["status"] != "cut") std::cerr << "warning: the cut missed the model\n";
     }
     if (tear_.enabled && !tear.done()) tear.advance(body, t);
-    if (drill_.enabled && !s.drill_done && t >= drill_.at - 1e-12) {
+    if (drill_.enabled && !s.drill_done && event_due(t, drill_.at)) {
       s.drill = apply_drill(body, bind, drill_);
       s.drill_done = true;
       if (s.drill["status"] != "drilled") std::cerr << "warning: the drill missed the model\n";

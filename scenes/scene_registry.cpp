@@ -2,9 +2,8 @@
 // static initialisation (SceneRegistration), and `conform run NAME` finds it by name, so a
 // new scene needs no edit outside its own file.
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 
+#include "bounded_read.hpp"
 #include "scene.hpp"
 
 namespace conform::scenes {
@@ -42,16 +41,16 @@ std::unique_ptr<Scene> load_scene(const std::string& name_or_file,
                                   const std::vector<std::string>& assignments, int steps_override) {
   if (const SceneKind* b = find_builtin(name_or_file))
     return prepare_scene(Json::parse(b->json), b->name, assignments, steps_override);
-  std::ifstream in(name_or_file);
-  if (!in) {
+  std::string text;
+  try {
+    text = read_bounded(name_or_file, "scene file");
+  } catch (const InputMissing&) {
     std::string names;
     for (const auto& s : scene_kinds()) names += (names.empty() ? "" : ", ") + std::string(s.name);
     throw std::runtime_error("'" + name_or_file + "' is neither a built-in scene (" + names +
                              ") nor a readable scene file");
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  return load_scene_text(text.str(), name_or_file, assignments, steps_override);
+  return load_scene_text(text, name_or_file, assignments, steps_override);
 }
 
 std::unique_ptr<Scene> load_scene_text(std::string_view text, const std::string& file,

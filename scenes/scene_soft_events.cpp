@@ -13,6 +13,7 @@
 #include "conform/mesh/analysis.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
+#include "event_time.hpp"
 #include "scene.hpp"
 #include "soft_scene.hpp"
 
@@ -152,6 +153,8 @@ class ArmEventScene : public Scene {
     body.set_pose_source([motion, rest](double t, skin::Pose& p) { motion.pose(rest, t, p); });
 
     const bool is_cut = kind_ == Kind::cut;
+    require_before_end(c, is_cut ? "cut.at" : "drill.at", at_, is_cut ? "the cut" : "the drill",
+                       at_);
     out.open_metrics(is_cut ? std::vector<std::string>{"t", "pieces", "offset_mean", "offset_max",
                                                        "hand_offset_mean", "hand_offset_max",
                                                        "rest_offset_mean", "nodes"}
@@ -172,7 +175,7 @@ class ArmEventScene : public Scene {
       w.step();
       physics_ms += std::chrono::duration<double, std::milli>(Clock::now() - tp).count();
       const double t = step * c.dt;
-      if (!done && t >= at_ - 1e-12) {
+      if (!done && event_due(t, at_)) {
         done = true;
         const auto te = Clock::now();
         event = is_cut ? cut_at(body, arm, t, special, others)
@@ -206,9 +209,6 @@ class ArmEventScene : public Scene {
       out.progress(step, c.steps);
     }
     const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
-    if (!done)
-      throw std::runtime_error(std::string(is_cut ? "cut" : "drill") + ": the event at " +
-                               std::to_string(at_) + " s is after the last step");
     if (!finite_nodes(body)) throw std::runtime_error("the soft body blew up (non-finite nodes)");
     const Json metrics = summary(body, event, all_special, worst_special, special_samples);
     add_plot(out);

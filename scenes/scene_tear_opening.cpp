@@ -20,6 +20,7 @@
 
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
+#include "event_time.hpp"
 #include "scene.hpp"
 #include "soft_scene.hpp"
 
@@ -114,6 +115,9 @@ class TearOpening final : public Scene {
 
   Json run(RunOutput& out) override {
     const CommonSettings& c = common_;
+    require_before_end(c, "tear.at", stroke_.at, "the tear's last sample (tear.at + tear.duration)",
+                       stroke_.time(stroke_.samples - 1));
+    if (flex_deg_ != 0) require_before_end(c, "pose.flex_at", flex_at_, "the flex", flex_at_);
     skin::Pose pose;
     TearRun r(posed_arm(pose), pose, c, material_);
     r.body.set_pose_source(flexing_pose(pose));
@@ -276,7 +280,7 @@ class TearOpening final : public Scene {
   // The stroke's samples due by time t cut both runs; Algorithm 2 step 6 opens the geometric
   // tear once the stroke is done.
   void advance_stroke(TearRun& r, double t) const {
-    while (r.next < stroke_.samples && stroke_.time(r.next) <= t + 1e-12) {
+    while (r.next < stroke_.samples && event_due(t, stroke_.time(r.next))) {
       const mesh::ScalpelSample sample = stroke_.sample(r.next);
       r.body.tear_advance(sample);
       r.geo_tear.advance(sample);

@@ -264,6 +264,7 @@ TEST(IoBroken, SpinningReadersStopAtTheTimeCap) {
   conform::io::ImportOptions o;
   o.isolate = true;
   o.isolation.seconds = 0.5;
+  o.isolation.seconds_per_mib = 0;
   for (const char* f : {"cube_uv_reader_spins.ply", "triangle_reader_spins.smd"}) {
     const std::string path = kBroken + f;
     try {

@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <assimp/Importer.hpp>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -586,8 +587,8 @@ ImportError isolation_error(const std::string& file, const Isolated& r,
       break;
     case S::timed_out:
       why << "reading it did not finish within " << limits.seconds
-          << " s (ImportOptions::isolation.seconds, --import-seconds); the file is corrupt or too "
-             "large";
+          << " s (its budget: ImportOptions::isolation.seconds + seconds_per_mib per MiB, "
+             "--import-seconds, --import-seconds-per-mib); the file is corrupt or too large";
       break;
     case S::crashed:
       why << "assimp crashed reading it (" << r.message
@@ -601,6 +602,10 @@ ImportError isolation_error(const std::string& file, const Isolated& r,
 }
 
 }  // namespace
+
+double import_seconds(const IsolationLimits& limits, std::uintmax_t file_bytes) {
+  return limits.seconds + limits.seconds_per_mib * (double(file_bytes) / 1048576.0);
+}
 
 int SkinnedModel::find_animation(const std::string& key) const {
   for (std::size_t i = 0; i < animations.size(); ++i)
@@ -647,11 +652,35 @@ SkinnedModel import_here(const std::string& file, const ImportOptions& options) 
   return std::move(b.model);
 }
 
+// The bytes a reader of `path` may read: the file, and the files beside it with the same stem
+// (a .gltf's .bin, an .md5mesh's .md5anim); for a .gltf, whose buffers may have any name,
+// every file of its folder.
+std::uintmax_t import_bytes(const std::filesystem::path& path) {
+  std::error_code ec;
+  std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (ec) bytes = 0;
+  std::string ext = path.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const bool whole_folder = ext == ".gltf";
+  const std::filesystem::path folder = path.has_parent_path() ? path.parent_path() : ".";
+  for (std::filesystem::directory_iterator it(folder, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    std::error_code e;
+    if (it->path().filename() == path.filename() || !it->is_regular_file(e)) continue;
+    if (whole_folder || it->path().stem() == path.stem()) {
+      const std::uintmax_t size = it->file_size(e);
+      if (!e) bytes += size;
+    }
+  }
+  return bytes;
+}
+
 // The import in a child process (isolate.hpp); this process only decodes the child's model.
 SkinnedModel import_isolated(const std::string& file, const ImportOptions& options) {
-  const Isolated r =
-      run_isolated([&] { return encode_model(import_here(file, options)); }, options.isolation);
-  if (r.status != Isolated::Status::ok) throw isolation_error(file, r, options.isolation);
+  IsolationLimits limits = options.isolation;
+  limits.seconds = import_seconds(options.isolation, import_bytes(file));
+  const Isolated r = run_isolated([&] { return encode_model(import_here(file, options)); }, limits);
+  if (r.status != Isolated::Status::ok) throw isolation_error(file, r, limits);
   SkinnedModel model;
   try {
     model = decode_model(r.result);

@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -230,16 +231,37 @@ std::string encode_ply(const Eigen::Ref<const Eigen::Matrix3Xd>& pos, const Attr
   return out;
 }
 
+// Finite or refused: a reader takes nan or inf in a file for a valid coordinate (or fails).
+void check_finite(const Eigen::Matrix3Xd& pos, const Selection& s) {
+  for (const std::int32_t v : s.vertices)
+    if (!pos.col(v).allFinite()) {
+      std::ostringstream why;
+      why << "mesh export: vertex " << v << " is not finite (" << pos(0, v) << ", " << pos(1, v)
+          << ", " << pos(2, v) << "); nothing written";
+      throw std::runtime_error(why.str());
+    }
+  if (!s.uvs.allFinite() || !s.normals.allFinite())
+    throw std::runtime_error("mesh export: a corner UV or normal is not finite; nothing written");
+}
+
 std::string encode(const mesh::SkinnedMesh& mesh, const Selection& s, const MeshExportOptions& o) {
   const auto& pos = o.rest_positions ? mesh.rest : mesh.current;
   if (pos.cols() != mesh.vertex_count())
     throw std::runtime_error("mesh export: position matrix does not match the vertex count");
+  check_finite(pos, s);
   const Attributes attributes(mesh, s, o);
   if (o.format == MeshFormat::Obj) return encode_obj(pos, attributes);
   return encode_ply(pos, attributes, o.format == MeshFormat::PlyBinary);
 }
 
 }  // namespace
+
+std::size_t mesh_file_size(const mesh::SkinnedMesh& mesh, const MeshExportOptions& options,
+                           std::span<const std::int32_t> faces) {
+  Selection selection = select(mesh, faces);
+  split_wedges(mesh, selection);
+  return encode(mesh, selection, options).size();
+}
 
 void write_mesh(const std::filesystem::path& path, const mesh::SkinnedMesh& mesh,
                 const MeshExportOptions& options, std::span<const std::int32_t> faces) {

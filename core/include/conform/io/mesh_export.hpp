@@ -15,6 +15,7 @@
 // is renamed over the target only once it is complete, so a reader never sees half a mesh.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <span>
@@ -45,9 +46,16 @@ const char* mesh_format_extension(MeshFormat format);
 
 /// Writes `mesh` to `path`. When `faces` is not empty only those faces (indices into
 /// mesh.faces) are written, with the vertices they use renumbered in increasing order; this is
-/// how one piece of a cut mesh is exported. Throws std::runtime_error on I/O failure (the
-/// target is then left untouched) and std::out_of_range on an invalid face or vertex index.
+/// how one piece of a cut mesh is exported. Throws std::runtime_error on I/O failure or a
+/// NaN or infinite position, UV or normal among the written vertices (the target is then left
+/// untouched) and std::out_of_range on an invalid face or vertex index.
 void write_mesh(const std::filesystem::path& path, const mesh::SkinnedMesh& mesh,
                 const MeshExportOptions& options = {}, std::span<const std::int32_t> faces = {});
+
+/// The size in bytes of the file that write_mesh would write now (encoded in memory, not
+/// written): for a cap on a command's output checked before anything is written. Throws as
+/// write_mesh does for a non-finite vertex or a bad index.
+std::size_t mesh_file_size(const mesh::SkinnedMesh& mesh, const MeshExportOptions& options = {},
+                           std::span<const std::int32_t> faces = {});
 
 }  // namespace conform::io
