@@ -18,15 +18,15 @@ fail() { echo "sweep_kill_test: $*" >&2; exit 1; }
 # Job control: a background job then gets SIGINT as a foreground one would (bash otherwise
 # starts it with SIGINT ignored), in a process group of its own.
 set -m
-# Points that run for hours (100000 steps of arm-track) unless stopped.
-long=(--steps 100000 --set outputs.frames_every=0 --set outputs.plots=false)
+# Points that run for hours (10^7 steps of arm-track, about 0.5 ms each) unless stopped.
+long=(--steps 10000000 --set outputs.frames_every=0 --set outputs.plots=false)
 
 # children <pid>: the pids of its child processes.
 children() { cat /proc/"$1"/task/*/children 2> /dev/null | tr ' ' '\n' | grep . || true; }
 # wait_points <sweep pid> <n>: waits (up to 60 s) until the sweep runs n points; prints their pids.
 wait_points() {
-  local pids=""
-  for _ in $(seq 600); do
+  local pids="" end=$((SECONDS + 60))
+  while [[ $SECONDS -lt $end ]]; do
     pids="$(children "$1")"
     [[ $(grep -c . <<< "$pids") -ge $2 ]] && { echo "$pids"; return; }
     kill -0 "$1" 2> /dev/null || break
@@ -36,7 +36,8 @@ wait_points() {
 }
 # gone <pid...>: waits (up to 20 s) until none of the processes lives; fails otherwise.
 gone() {
-  for _ in $(seq 200); do
+  local end=$((SECONDS + 20))
+  while [[ $SECONDS -lt $end ]]; do
     local alive=0
     for pid in "$@"; do
       [[ -e /proc/$pid && "$(awk '{print $3}' /proc/"$pid"/stat 2> /dev/null)" != Z ]] && alive=1
@@ -88,7 +89,8 @@ rc=0
   > "$tmp/second.log" 2> "$tmp/second.err" &
 second=$!
 # The second sweep must not start a point; it ends by itself (refused).
-for _ in $(seq 600); do kill -0 "$second" 2> /dev/null || break; sleep 0.1; done
+end=$((SECONDS + 60))
+while [[ $SECONDS -lt $end ]] && kill -0 "$second" 2> /dev/null; do sleep 0.1; done
 started+=($(children "$second"))
 kill -0 "$second" 2> /dev/null && { kill -TERM "$second"; fail "the second sweep did not stop by itself"; }
 wait "$second" || rc=$?
@@ -106,7 +108,7 @@ kill -TERM "$sweep"
 gone "${points[@]}"
 
 # --- a resume right after SIGKILL -------------------------------------------------------------
-# Points of a few seconds each: the killed sweep's points would still be running when the
+# Points of a second or two each: the killed sweep's points would still be running when the
 # resume starts, if they outlived it.
 mid=(--steps 3000 --set outputs.frames_every=0 --set outputs.plots=false)
 "$conform" sweep arm-track --grid arm.kp=0.3,0.5 "${mid[@]}" --jobs 2 --out "$tmp/resume" \
