@@ -5,6 +5,7 @@
 // `conform sweep --task N DIR`; `conform sweep --gather DIR` collects what has finished.
 #include <unistd.h>
 
+#include <algorithm>
 #include <iostream>
 #include <memory>
 #include <thread>
@@ -12,8 +13,10 @@
 #include "commands.hpp"
 #include "conform/version.hpp"
 #include "scene.hpp"
+#include "sweep_lock.hpp"
 #include "sweep_plots.hpp"
 #include "sweep_pool.hpp"
+#include "sweep_signals.hpp"
 #include "sweep_slurm.hpp"
 #include "sweep_table.hpp"
 
@@ -30,31 +33,42 @@ struct SweepArgs {
   int repeat = 1, steps = 0, jobs = 0, task = -1, array_limit = 0;
   bool gather = false, slurm = false, submit = false;
   std::string partition, time;
+  std::vector<std::string> sbatch_lines;
 };
 
-std::string command_line(const SweepArgs& a) {
-  std::string s = "conform sweep " + a.target;
-  for (const auto& g : a.grids) s += " --grid " + g;
-  for (const auto& z : a.zips) s += " --zip " + z;
-  for (const auto& x : a.sets) s += " --set " + x;
+// A word for sh: as it is when that is safe, quoted otherwise.
+std::string word(const std::string& s) {
+  const bool plain = !s.empty() && s.find_first_not_of(
+                                       "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMN"
+                                       "OPQRSTUVWXYZ0123456789_-+=.,/:@%") == std::string::npos;
+  return plain ? s : scenes::shell_quote(s);
+}
+
+// The sweep's command, to be pasted into a shell from any folder (it resumes the sweep).
+std::string command_line(const SweepArgs& a, const std::string& scene) {
+  std::string s = "conform sweep " + word(scene);
+  for (const auto& g : a.grids) s += " --grid " + word(g);
+  for (const auto& z : a.zips) s += " --zip " + word(z);
+  for (const auto& x : a.sets) s += " --set " + word(x);
   if (a.repeat > 1) s += " --repeat " + std::to_string(a.repeat);
   if (a.steps > 0) s += " --steps " + std::to_string(a.steps);
   if (!a.plot.empty()) {
-    s += " --plot ";
-    for (std::size_t i = 0; i < a.plot.size(); ++i) s += (i ? "," : "") + a.plot[i];
+    std::string metrics;
+    for (std::size_t i = 0; i < a.plot.size(); ++i) metrics += (i ? "," : "") + a.plot[i];
+    s += " --plot " + word(metrics);
   }
-  return s + " --out " + a.out;
+  return s + " --out " + word(fs::absolute(a.out).lexically_normal().string());
 }
 
 // The sweep described by the arguments, every point validated; nothing is written.
 SweepSpec plan(const SweepArgs& a) {
   SweepSpec spec;
-  spec.command = command_line(a);
   spec.version = conform::version();
   // A scene file is named by its absolute path: tasks may run from any folder.
   spec.scene = scenes::find_builtin(a.target) || !fs::exists(a.target)
                    ? a.target
                    : fs::absolute(a.target).lexically_normal().string();
+  spec.command = command_line(a, spec.scene);
   spec.steps = a.steps;
   spec.sets = a.sets;
   spec.repeat = a.repeat;
@@ -64,6 +78,19 @@ SweepSpec plan(const SweepArgs& a) {
   spec.points = scenes::expand(spec.axes, a.repeat);
   scenes::validate_points(spec);
   return spec;
+}
+
+// How to run the failed and missing points again: the array's tasks when the sweep has a job
+// array, and the sweep's own command (which skips finished points).
+void print_rerun(const SweepSpec& spec, const scenes::SweepTable& table, const fs::path& dir) {
+  std::vector<int> todo = table.missing;
+  for (const auto& r : table.rows)
+    if (r.status.state == scenes::PointStatus::State::Failed) todo.push_back(r.point->index);
+  std::sort(todo.begin(), todo.end());
+  if (todo.empty()) return;
+  const std::string sbatch = scenes::resubmit_command(dir, todo);
+  if (!sbatch.empty()) std::cout << "resubmit them: " << sbatch << "\n";
+  std::cout << (sbatch.empty() ? "run them again: " : "or run them here: ") << spec.command << "\n";
 }
 
 // Table and plots from whatever has finished; the exit code (0: every point finished).
@@ -85,7 +112,12 @@ int gather(const SweepSpec& spec, const fs::path& dir) {
   for (const auto& p : plots.problems) std::cout << "  plot not drawn: " << p << "\n";
   std::cout << "table: " << (dir / "sweep.csv").string() << "\n";
   for (const auto& p : plots.drawn) std::cout << "plot: " << p << "\n";
-  return failed == 0 && table.missing.empty() ? 0 : 1;
+  print_rerun(spec, table, dir);
+  if (failed == 0 && table.missing.empty()) return 0;
+  std::cout << std::flush;
+  std::cerr << "conform sweep: " << failed << " of " << spec.points.size() << " points failed, "
+            << table.missing.size() << " missing (" << (dir / "sweep.csv").string() << ")\n";
+  return 1;
 }
 
 // Writes (or checks) DIR/sweep.json: a folder holds one sweep, resumed only with the same runs.
@@ -108,12 +140,16 @@ int sweep_main(const SweepArgs& a) {
     if (a.gather && a.task >= 0)
       throw scenes::SceneError("--task", std::to_string(a.task), "and --gather are exclusive");
     if (!a.grids.empty() || !a.zips.empty() || !a.sets.empty() || !a.plot.empty() ||
-        !a.out.empty() || a.steps > 0 || a.repeat > 1 || a.slurm || a.submit)
+        !a.out.empty() || a.steps > 0 || a.repeat > 1 || a.slurm || a.submit ||
+        !a.sbatch_lines.empty())
       throw scenes::SceneError(a.gather ? "--gather" : "--task", a.target,
                                "takes only the sweep folder (its sweep.json holds the rest)");
     const fs::path dir = a.target;
     const SweepSpec spec = scenes::read_spec(dir);
-    if (a.gather) return gather(spec, dir);
+    if (a.gather) {
+      const scenes::SweepLock lock(dir);  // not while a local sweep writes the table
+      return gather(spec, dir);
+    }
     if (a.task >= static_cast<int>(spec.points.size()))
       throw scenes::SceneError(
           "--task", std::to_string(a.task),
@@ -126,9 +162,17 @@ int sweep_main(const SweepArgs& a) {
   slurm.partition = a.partition;
   slurm.time = a.time;
   slurm.array_limit = a.array_limit;
+  slurm.lines = a.sbatch_lines;
+  if (!slurm.lines.empty() && !a.slurm && !a.submit)
+    throw scenes::SceneError("--sbatch-line", scenes::show(scenes::Json(slurm.lines.front())),
+                             "needs --slurm or --submit");
   scenes::check_slurm_options(slurm);
   const SweepSpec spec = plan(a);
   const fs::path dir = a.out;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw std::runtime_error("cannot create " + dir.string() + ": " + ec.message());
+  const scenes::SweepLock lock(dir);  // held (by the points too) until the sweep has ended
   claim_folder(spec, dir);
   std::cout << "conform sweep " << spec.scene << ": " << spec.points.size() << " points into "
             << dir.string() << "\n"
@@ -142,15 +186,16 @@ int sweep_main(const SweepArgs& a) {
       std::cout << "note: " << spec.points.size() << " tasks: Slurm's default MaxArraySize is "
                 << "1001 (`scontrol show config | grep MaxArraySize` shows the cluster's)\n";
     if (!a.submit) {
-      std::cout << "submit it with: sbatch " << file.string() << "\n";
+      std::cout << "submit it with: sbatch " << word(file.string()) << "\n";
       return 0;
     }
     std::cout << "submitted job " << scenes::submit_sbatch(file) << "\n"
-              << "when it is done: conform sweep --gather " << dir.string() << "\n";
+              << "when it is done: conform sweep --gather " << word(file.parent_path().string())
+              << "\n";
     return 0;
   }
   const int jobs = a.jobs > 0 ? a.jobs : int(std::max(1u, std::thread::hardware_concurrency()));
-  scenes::run_pool(spec, dir, jobs);
+  scenes::run_pool(spec, dir, jobs, -1, lock.fd());
   return gather(spec, dir);
 }
 
@@ -182,6 +227,9 @@ void register_sweep(CLI::App& app, Context& context) {
   cmd->add_option("--time", a->time, "Slurm time limit per task (e.g. 00:10:00)");
   cmd->add_option("--array-limit", a->array_limit, "most array tasks running at once")
       ->check(CLI::Range(0, scenes::kMaxSweepPoints));
+  cmd->add_option("--sbatch-line", a->sbatch_lines,
+                  "an #SBATCH directive for the job array, e.g. --mem=4G (repeatable)")
+      ->allow_extra_args(false);
   cmd->add_flag("--submit", a->submit, "submit sweep.sbatch with sbatch (implies --slurm)");
   cmd->add_option("--task", a->task, "run point N of the sweep in folder TARGET")
       ->check(CLI::Range(0, scenes::kMaxSweepPoints));
@@ -189,6 +237,13 @@ void register_sweep(CLI::App& app, Context& context) {
   cmd->callback([&context, a]() {
     try {
       context.exit_code = sweep_main(*a);
+    } catch (const scenes::SweepInterrupted& e) {
+      std::cerr << "conform sweep: " << e.what()
+                << ": the points it stopped are missing; the same command resumes the sweep\n";
+      context.exit_code = 128 + e.signal();
+    } catch (const scenes::SweepBusy& e) {
+      std::cerr << "conform sweep: " << e.what() << " (nothing run)\n";
+      context.exit_code = 2;
     } catch (const scenes::SceneError& e) {
       std::cerr << "conform sweep: " << a->target << ": " << e.what() << " (nothing run)\n";
       context.exit_code = 2;

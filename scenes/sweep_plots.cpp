@@ -1,6 +1,7 @@
 #include "sweep_plots.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -30,14 +31,28 @@ bool numeric(const std::string& s, double& x) {
   return end != s.c_str() && *end == '\0';
 }
 
-// gnuplot's enhanced text reads _ ^ { } @ & as markup; metric and key names are literal.
+// Keys and values as literal gnuplot enhanced text that holds no character gnuplot's string
+// syntax reads: markup (_ ^ { } & ~) escaped with a backslash, and quotes, backquotes (a command
+// inside a double-quoted string), backslashes, $ ; @ and control characters (a line break would
+// end the string and start a command) as the enhanced-text octal code \ooo. So the text is safe
+// in a gnuplot string of either kind. gnuplot decodes \ooo only in text it reads as markup: a
+// leading {} (an empty group) says that it is.
 std::string literal(const std::string& s) {
   std::string out;
+  bool coded = false;
   for (char c : s) {
-    if (std::string("_^{}@&").find(c) != std::string::npos) out += '\\';
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x20 || u == 0x7f || std::string("`\"'\\$;@").find(c) != std::string::npos) {
+      char code[8];
+      std::snprintf(code, sizeof code, "\\%03o", unsigned(u));
+      out += code;
+      coded = true;
+      continue;
+    }
+    if (std::string("_^{}&~").find(c) != std::string::npos) out += '\\';
     out += c;
   }
-  return out;
+  return coded ? "{}" + out : out;
 }
 
 std::string file_stem(const std::string& s) {

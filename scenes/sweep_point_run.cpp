@@ -1,15 +1,15 @@
 #include "sweep_point_run.hpp"
 
 #include <fcntl.h>
-#include <spawn.h>
+#include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <chrono>
 #include <cstring>
 #include <fstream>
-
-extern char** environ;
 
 namespace conform::scenes {
 
@@ -42,15 +42,53 @@ PointStatus read_status(const fs::path& dir, int index) {
     s.wall_s = j.value("wall_s", 0.0);
   }
   if (summary_complete(point_dir(dir, index))) {
+    // A complete summary is the point's result. A record of another outcome (none, or an
+    // attempt that failed while another run of the point finished it) is not this result's.
     s.state = PointStatus::State::Done;
-    if (s.exit_code < 0) s.exit_code = 0;  // finished, but its status was not recorded
+    if (s.exit_code != 0) s = {PointStatus::State::Done, 0, "", 0.0};
   } else if (j.is_object() && s.exit_code != 0) {
     s.state = PointStatus::State::Failed;
   }
   return s;
 }
 
-PointProcess start_point(const SweepSpec& spec, const fs::path& dir, int index) {
+namespace {
+
+// In the child, between fork and exec: only async-signal-safe calls (everything the exec needs
+// was made before the fork).
+[[noreturn]] void exec_point(pid_t sweep, char* const argv[], int out, int err, int keep_fd) {
+  // The same binary as this process, whatever PATH says.
+  // The kernel sends SIGTERM when the sweep dies, however it dies (the run then ends as it does
+  // on a kill: nothing half-written is kept). It follows the forking thread: the pool forks
+  // from the sweep's main thread.
+  ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+  if (::getppid() != sweep) ::_exit(127);  // the sweep died before prctl took effect
+  // The sweep's own handlers and mask are not the run's.
+  struct sigaction dfl = {};
+  dfl.sa_handler = SIG_DFL;
+  for (int sig : {SIGTERM, SIGINT, SIGHUP, SIGCHLD}) ::sigaction(sig, &dfl, nullptr);
+  sigset_t none;
+  sigemptyset(&none);
+  ::sigprocmask(SIG_SETMASK, &none, nullptr);
+  const int null = ::open("/dev/null", O_RDONLY);
+  if (null < 0 || ::dup2(null, 0) < 0 || ::dup2(out, 1) < 0 || ::dup2(err, 2) < 0) ::_exit(127);
+  if (keep_fd >= 0) ::fcntl(keep_fd, F_SETFD, 0);  // the sweep's lock, held while the run lives
+  ::execv("/proc/self/exe", argv);
+  const char message[] = "conform sweep: cannot run /proc/self/exe\n";
+  [[maybe_unused]] const ssize_t n = ::write(2, message, sizeof message - 1);
+  ::_exit(127);
+}
+
+int open_record(const fs::path& file) {
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0)
+    throw std::runtime_error("cannot write " + file.string() + ": " + std::strerror(errno));
+  return fd;
+}
+
+}  // namespace
+
+PointProcess start_point(const SweepSpec& spec, const fs::path& dir, int index, int inherit_fd) {
   const fs::path folder = point_dir(dir, index);
   std::error_code ec;
   fs::create_directories(folder.parent_path(), ec);
@@ -64,22 +102,26 @@ PointProcess start_point(const SweepSpec& spec, const fs::path& dir, int index) 
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  const std::string log = point_record(dir, index, "out").string(),
-                    err = point_record(dir, index, "err").string();
-  posix_spawn_file_actions_addopen(&actions, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  const int out = open_record(point_record(dir, index, "out"));
+  int err = -1;
+  try {
+    err = open_record(point_record(dir, index, "err"));
+  } catch (...) {
+    ::close(out);
+    throw;
+  }
   PointProcess p;
   p.index = index;
   p.started = monotonic_seconds();
-  // The same binary as this process, whatever PATH says.
-  const int rc = posix_spawn(&p.pid, "/proc/self/exe", &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (rc != 0)
+  const pid_t sweep = ::getpid();
+  p.pid = ::fork();
+  if (p.pid == 0) exec_point(sweep, argv.data(), out, err, inherit_fd);
+  const int fork_error = errno;
+  ::close(out);
+  ::close(err);
+  if (p.pid < 0)
     throw std::runtime_error("cannot start conform run for point " + std::to_string(index) + ": " +
-                             std::strerror(rc));
+                             std::strerror(fork_error));
   return p;
 }
 

@@ -1,5 +1,6 @@
 #include "sweep_pool.hpp"
 
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 
 #include "progress.hpp"
 #include "sweep_point_run.hpp"
+#include "sweep_signals.hpp"
 
 namespace conform::scenes {
 
@@ -55,7 +57,56 @@ class SweepProgress {
 
 }  // namespace
 
-PoolResult run_pool(const SweepSpec& spec, const fs::path& dir, int jobs, int only) {
+namespace {
+
+// The points running now. Leaving early (a signal, an error) stops them and waits for them:
+// no point outlives the pool.
+class RunningPoints {
+ public:
+  ~RunningPoints() { stop(nullptr); }
+  void add(const PointProcess& p) { points_[p.pid] = p; }
+  std::size_t size() const { return points_.size(); }
+
+  /// Reaps every point that has ended, calling `ended(process, wait status)` for each.
+  template <class Ended>
+  void reap(Ended ended) {
+    for (auto it = points_.begin(); it != points_.end();) {
+      int wstatus = 0;
+      const pid_t r = ::waitpid(it->first, &wstatus, WNOHANG);
+      if (r == 0 || (r < 0 && errno == EINTR)) {
+        ++it;
+        continue;
+      }
+      if (r == it->first) ended(it->second, wstatus);
+      it = points_.erase(it);  // or not ours to wait for any more (ECHILD)
+    }
+  }
+
+  /// SIGTERM to every point, then waits for them all; a stopping signal meanwhile (a second
+  /// Ctrl-C) sends SIGKILL. Without `signals` it waits without listening.
+  void stop(SweepSignals* signals) {
+    for (const auto& [pid, p] : points_) ::kill(pid, SIGTERM);
+    const auto forget = [](const PointProcess&, int) {};
+    while (!points_.empty()) {
+      reap(forget);
+      if (points_.empty()) break;
+      if (!signals) {
+        int wstatus = 0;
+        if (::waitpid(points_.begin()->first, &wstatus, 0) >= 0 || errno != EINTR)
+          points_.erase(points_.begin());
+      } else if (signals->wait() != 0) {
+        for (const auto& [pid, p] : points_) ::kill(pid, SIGKILL);
+      }
+    }
+  }
+
+ private:
+  std::map<pid_t, PointProcess> points_;
+};
+
+}  // namespace
+
+PoolResult run_pool(const SweepSpec& spec, const fs::path& dir, int jobs, int only, int lock_fd) {
   PoolResult result;
   std::vector<int> todo;
   for (const auto& p : spec.points) {
@@ -66,25 +117,27 @@ PoolResult run_pool(const SweepSpec& spec, const fs::path& dir, int jobs, int on
       todo.push_back(p.index);
   }
   SweepProgress progress(result.skipped + static_cast<int>(todo.size()), result.skipped);
-  std::map<pid_t, PointProcess> running;
-  std::size_t next = 0;
-  while (next < todo.size() || !running.empty()) {
-    while (next < todo.size() && static_cast<int>(running.size()) < std::max(1, jobs)) {
-      const PointProcess p = start_point(spec, dir, todo[next++]);
-      running[p.pid] = p;
-    }
-    int wstatus = 0;
-    const pid_t pid = ::waitpid(-1, &wstatus, 0);
-    if (pid < 0) {
-      if (errno == EINTR) continue;
-      throw std::runtime_error("waitpid failed: " + std::string(std::strerror(errno)));
-    }
-    const auto it = running.find(pid);
-    if (it == running.end()) continue;  // not one of ours (e.g. a gnuplot of a caller)
-    const PointStatus s = finish_point(dir, it->second, wstatus);
-    progress.report(spec.points[std::size_t(it->second.index)], s);
+  SweepSignals signals;  // before the first fork: no SIGCHLD is missed
+  RunningPoints running;
+  const auto ended = [&](const PointProcess& process, int wstatus) {
+    const PointStatus s = finish_point(dir, process, wstatus);
+    progress.report(spec.points[std::size_t(process.index)], s);
     (s.state == PointStatus::State::Done ? result.done : result.failed) += 1;
-    running.erase(it);
+  };
+  std::size_t next = 0;
+  for (;;) {
+    while (next < todo.size() && static_cast<int>(running.size()) < std::max(1, jobs))
+      running.add(start_point(spec, dir, todo[next++], lock_fd));
+    // A stop that came as the last point ended still stops the sweep.
+    const int stop = signals.wait(running.size() > 0 ? -1 : 0);
+    if (stop != 0) {
+      std::cerr << "conform sweep: " << sigabbrev(stop) << ": stopping " << running.size()
+                << " running point" << (running.size() == 1 ? "" : "s") << "\n";
+      running.stop(&signals);
+      throw SweepInterrupted(stop);
+    }
+    running.reap(ended);
+    if (running.size() == 0 && next == todo.size()) break;
   }
   return result;
 }

@@ -92,10 +92,13 @@ done
 
 # The sweep as a job array, through conform itself.
 grid=(--grid arm.kp=0.3,0.5 --grid physics.substeps=1,2 --steps 20 --set outputs.frames_every=0)
+# --sbatch-line passes any directive: the job carries the comment.
 "$conform" sweep arm-track "${grid[@]}" --slurm --submit --partition conformq --time 00:05:00 \
-  --array-limit 2 --out "$tmp/slurm" > "$tmp/submit.log" 2>&1 || { cat "$tmp/submit.log" >&2; fail "submit failed"; }
+  --array-limit 2 --sbatch-line=--comment=from-sbatch-line --out "$tmp/slurm" > "$tmp/submit.log" 2>&1 ||
+  { cat "$tmp/submit.log" >&2; fail "submit failed"; }
 job="$(sed -n 's/^submitted job \([0-9][0-9]*\)$/\1/p' "$tmp/submit.log")"
 [[ -n "$job" ]] || { cat "$tmp/submit.log" >&2; fail "no job id printed"; }
+[[ "$(scontrol show job "$job")" == *Comment=from-sbatch-line* ]] || fail "the --sbatch-line directive did not reach the job"
 done_=0
 for _ in $(seq 600); do
   if [[ -z "$(squeue -h -j "$job" 2> /dev/null)" ]]; then done_=1; break; fi

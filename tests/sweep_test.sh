@@ -73,6 +73,17 @@ grep -q "5 of 6 points already finished, skipped" "$tmp/rerun.log" || { cat "$tm
 [[ $(grep -c "^sweep: point" "$tmp/rerun.log") -eq 1 ]] || fail "rerun ran more than the lost point"
 [[ "$(stat -c %i-%Y "$tmp/grid/runs/00003/summary.json")" == "$stamp" ]] || fail "a finished point was rewritten"
 [[ $(tail -n +2 "$tmp/grid/sweep.csv" | wc -l) -eq 6 ]] || fail "rerun table does not have 6 rows"
+# A point whose summary is complete is done, exit 0, whatever an attempt that failed beside
+# the run that finished it recorded (a resume beside a killed sweep's points wrote ok, exit 1).
+echo '{"index": 2, "exit_code": 1, "error": "another run is writing it", "wall_s": 0.1}' \
+  > "$tmp/grid/runs/00002.status.json"
+"$conform" sweep --gather "$tmp/grid" > "$tmp/regather.log" 2>&1 || { cat "$tmp/regather.log" >&2; fail "gather of a done point with a failed record"; }
+grep -q "6 of 6 points finished, 0 failed, 0 missing" "$tmp/regather.log" || { cat "$tmp/regather.log" >&2; fail "regather counts"; }
+python3 - "$tmp/grid" <<'PY' || fail "a row's status does not match its exit code"
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1] + "/sweep.csv")))
+assert [(r["status"], r["exit_code"], r["error"]) for r in rows] == [("ok", "0", "")] * 6, rows
+PY
 # A different grid into the same folder is refused.
 rc=0; "$conform" sweep arm-track --grid arm.kp=0.3 "${short[@]}" --out "$tmp/grid" 2> "$tmp/err" > /dev/null || rc=$?
 [[ $rc -eq 2 ]] && grep -q "holds another sweep" "$tmp/err" || fail "another sweep into the same folder was not refused"
@@ -132,15 +143,36 @@ PY
 grep -q "plot not drawn: no_such_metric: not a numeric metric of these runs (known: .*rms_error" "$tmp/zip.log" ||
   { cat "$tmp/zip.log" >&2; fail "a misspelt --plot metric is not reported"; }
 
+# --- values reach gnuplot as text, never as commands -----------------------------------------
+# A free-text key swept beside a numeric one: its values are the plot's line titles. Backquotes
+# (a command inside a gnuplot double-quoted string), $(...), quotes, ';', '@' and a line break.
+vals=$'description=a`touch BQ`;b@c,d$(touch DS)\nsystem "touch NL"\'q"'
+"$conform" sweep arm-track --grid "$vals" --grid arm.kp=0.3,0.5 "${short[@]}" --plot rms_error \
+  --out "$tmp/quote" > "$tmp/quote.log" 2>&1 || { cat "$tmp/quote.log" >&2; fail "the sweep of odd values failed"; }
+[[ -z "$(find "$tmp" -name BQ -o -name DS -o -name NL)" ]] || fail "a sweep value ran as a command in gnuplot"
+[[ -s "$tmp/quote/plots/rms_error_vs_arm_kp.png" ]] || { cat "$tmp/quote.log" >&2; fail "odd values kept the plot from being drawn"; }
+! grep -q '[`$;@]' "$tmp/quote/plots/rms_error_vs_arm_kp.gp" || fail "a gnuplot script holds a raw \` \$ ; or @"
+[[ $(grep -c '^     "data/\|^plot "data/' "$tmp/quote/plots/rms_error_vs_arm_kp.gp") -eq 2 ]] ||
+  fail "rms_error vs arm.kp should have 2 lines (one per description)"
+# The values themselves reached the runs unchanged.
+python3 - "$tmp/quote" <<'PY' || fail "odd values did not reach the runs"
+import json, sys
+d = sys.argv[1]
+got = {json.load(open(f"{d}/runs/{i:05d}/summary.json"))["settings"]["description"] for i in range(4)}
+assert got == {"a`touch BQ`;b@c", 'd$(touch DS)\nsystem "touch NL"\'q"'}, got
+PY
+
 # --- --slurm writes a well-formed job array; --task and --gather run it by hand ---------------
 "$conform" sweep arm-track --grid arm.kp=0.3,0.5 --grid physics.substeps=1,2 "${short[@]}" \
-  --slurm --partition debug --time 00:05:00 --array-limit 3 --out "$tmp/task" > "$tmp/slurm.log" 2>&1 ||
+  --slurm --partition debug --time 00:05:00 --array-limit 3 --sbatch-line --mem=2G \
+  --sbatch-line '--account=my proj' --sbatch-line "-q low" --out "$tmp/task" > "$tmp/slurm.log" 2>&1 ||
   { cat "$tmp/slurm.log" >&2; fail "--slurm failed"; }
 sb="$tmp/task/sweep.sbatch"
 bash -n "$sb" || fail "sweep.sbatch is not valid bash"
 [[ "$(head -1 "$sb")" == "#!/bin/bash" ]] || fail "sweep.sbatch has no shebang"
 for line in "#SBATCH --array=0-3%3" "#SBATCH --partition=debug" "#SBATCH --time=00:05:00" \
-            "#SBATCH --chdir=$tmp/task" "#SBATCH --output=$tmp/task/slurm/%A_%a.out"; do
+            "#SBATCH --chdir=$tmp/task" "#SBATCH --output=$tmp/task/slurm/%A_%a.out" \
+            "#SBATCH --mem=2G" "#SBATCH --account=my proj" "#SBATCH -q low"; do
   grep -qxF -- "$line" "$sb" || fail "sweep.sbatch lacks '$line'"
 done
 # Slurm stops reading #SBATCH lines at the first command.
@@ -157,7 +189,18 @@ grep -q "2 of 4 points finished, 0 failed, 2 missing" "$tmp/gather.log" || { cat
 grep -q "missing: point 1 (arm.kp=0.3, physics.substeps=2)" "$tmp/gather.log" || fail "gather does not list the missing point"
 grep -q "missing: point 2 (arm.kp=0.5, physics.substeps=1)" "$tmp/gather.log" || fail "gather does not list the missing point"
 [[ $(tail -n +2 "$tmp/task/sweep.csv" | wc -l) -eq 2 ]] || fail "partial table should have 2 rows"
-for n in 1 2; do "$conform" sweep --task $n "$tmp/task" > /dev/null 2>&1 || fail "task $n failed"; done
+# It says how to run the missing points again: the array's tasks, or the sweep's own command.
+grep -qxF "resubmit them: sbatch --array=1-2%3 '$tmp/task/sweep.sbatch'" "$tmp/gather.log" ||
+  { cat "$tmp/gather.log" >&2; fail "gather does not print the sbatch command for the missing points"; }
+grep -q "^conform sweep: 0 of 4 points failed, 2 missing" "$tmp/gather.log" || fail "no summary of the failure"
+here="$(sed -n 's/^or run them here: //p' "$tmp/gather.log")"
+[[ "$here" == "conform sweep arm-track --grid arm.kp=0.3,0.5 --grid physics.substeps=1,2 --set outputs.frames_every=0 --steps 20 --out $tmp/task" ]] ||
+  fail "the local command is not the sweep's: $here"
+"$conform" sweep --task 1 "$tmp/task" > /dev/null 2>&1 || fail "task 1 failed"
+# The printed command, pasted into a shell in another folder, runs what is left (point 2).
+mkdir -p "$tmp/bin" && ln -sf "$conform" "$tmp/bin/conform"
+(cd / && PATH="$tmp/bin:$PATH" bash -c "$here") > "$tmp/here.log" 2>&1 || { cat "$tmp/here.log" >&2; fail "the printed command failed"; }
+grep -q "3 of 4 points already finished" "$tmp/here.log" || { cat "$tmp/here.log" >&2; fail "the printed command did not resume"; }
 "$conform" sweep --task 0 "$tmp/task" > "$tmp/again.log" 2>&1 || fail "a finished task should succeed"
 grep -q "already finished" "$tmp/again.log" || fail "a finished task ran again"
 "$conform" sweep --gather "$tmp/task" > "$tmp/gather2.log" 2>&1 || { cat "$tmp/gather2.log" >&2; fail "full gather failed"; }
@@ -201,6 +244,15 @@ expect_refused "--zip axes must have the same length" --zip arm.kp=0.3,0.5 --zip
 expect_refused "cannot be swept with --repeat" --grid seed=1,2 --repeat 2
 expect_refused "key '--time', value \"10 minutes\": must be one word" --grid arm.kp=0.3 --slurm --time "10 minutes"
 expect_refused "key '--time', value 1:2:3:4: is not a Slurm time" --grid arm.kp=0.3 --slurm --time 1:2:3:4
+# An #SBATCH line is one line (a line break would start a command of the script), an option,
+# and not the array.
+expect_refused "key '--sbatch-line', value \"--mem=1G\\\\ntouch /tmp/x\": must be one line" --grid arm.kp=0.3 --slurm \
+  --sbatch-line $'--mem=1G\ntouch /tmp/x'
+expect_refused "key '--sbatch-line', value \"--mem=1G\\\\r\": must be one line" --grid arm.kp=0.3 --slurm --sbatch-line $'--mem=1G\r'
+expect_refused "key '--sbatch-line', value \"mem=4G\": must be an sbatch option" --grid arm.kp=0.3 --slurm --sbatch-line mem=4G
+expect_refused "value \"--array=0-9\": the array is the sweep's points" --grid arm.kp=0.3 --slurm --sbatch-line --array=0-9
+expect_refused "value \"-a 0-9\": the array is the sweep's points" --grid arm.kp=0.3 --slurm --sbatch-line "-a 0-9"
+expect_refused "key '--sbatch-line', value \"--mem=1G\": needs --slurm or --submit" --grid arm.kp=0.3 --sbatch-line --mem=1G
 rc=0; "$conform" sweep --task 9 "$tmp/task" 2> "$tmp/err" || rc=$?
 [[ $rc -eq 2 ]] && grep -q "is not a point of this sweep (0..3)" "$tmp/err" || fail "--task 9 was not refused"
 rc=0; "$conform" sweep --gather "$tmp/task" --grid arm.kp=1 2> "$tmp/err" || rc=$?
