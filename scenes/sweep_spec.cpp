@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <fstream>
 
+#include "bounded_read.hpp"
 #include "scene.hpp"
 
 namespace conform::scenes {
@@ -85,10 +86,14 @@ SweepSpec from_json(const Json& j) {
 
 SweepSpec read_spec(const fs::path& dir) {
   const fs::path file = dir / "sweep.json";
-  std::ifstream in(file);
-  if (!in) throw std::runtime_error(file.string() + ": cannot read (is this a sweep folder?)");
+  std::string text;
   try {
-    return from_json(Json::parse(in));
+    text = read_bounded(file.string(), "sweep file");
+  } catch (const InputMissing&) {
+    throw std::runtime_error(file.string() + ": cannot read (is this a sweep folder?)");
+  }
+  try {
+    return from_json(Json::parse(text));
   } catch (const std::exception& e) {
     throw std::runtime_error(file.string() + ": not a sweep description: " + e.what());
   }
