@@ -299,7 +299,7 @@ struct TornArm {
     bullet::Material material;
     material.solver.threads = threads;
     if (variant == kMembranePrevious) {
-      material.solver.tolerance = 1.0;
+      material.solver.relative_tolerance = 1.0 / material.skin.stress_scale();
       material.solver.preconditioner = membrane::Preconditioner::block_jacobi;
     }
     if (variant == kLinks)

@@ -62,7 +62,12 @@ void read_skin(Reader& r, const bullet::Material& d, bullet::Material& m) {
       r.number("attachment_normal_stiffness", e.attachment_normal_stiffness, 0, 1e12);
   k.attachment_damping = r.number("attachment_damping", e.attachment_damping, 0, 1e9);
   k.wrinkling = r.boolean("wrinkling", e.wrinkling);
-  m.solver.tolerance = r.number("tolerance", d.solver.tolerance, 1e-9, 1e9);
+  if (r.has("tolerance"))
+    r.fail("tolerance", r.number("tolerance", 0),
+           "was an absolute residual in Pa; the membrane's stopping test is now "
+           "\"relative_tolerance\", dimensionless (the residual over the pre-stress, e.g. 1.2e-3)");
+  m.solver.relative_tolerance =
+      r.number("relative_tolerance", d.solver.relative_tolerance, 1e-12, 1);
   m.solver.max_newton_iterations =
       r.integer("max_newton_iterations", d.solver.max_newton_iterations, 1, 10000);
   m.solver.max_cg_iterations =

@@ -20,12 +20,14 @@ struct SlitResult {
   SolveReport report;
 };
 
-SlitResult solve_slit(const SlitSheetOptions& options, double sxx, double syy) {
+// axis: the material's prestress_axis (its default is (0, 0, 1), the sheet's normal).
+SlitResult solve_slit(const SlitSheetOptions& options, double sxx, double syy,
+                      const Eigen::Vector3d& axis = Eigen::Vector3d::UnitX()) {
   SlitSheet sheet = make_slit_sheet(options);
   mesh::apply(sheet.mesh, sheet.slit);
   SkinMaterial material;
   material.prestress = {sxx, syy};
-  material.prestress_axis = Eigen::Vector3d::UnitX();
+  material.prestress_axis = axis;
   material.attachment_stiffness = 0;
   material.attachment_normal_stiffness = 0;
   material.wrinkling = false;  // LEFM is linear elasticity: its sheet carries compression
@@ -37,7 +39,7 @@ SlitResult solve_slit(const SlitSheetOptions& options, double sxx, double syy) {
   const Eigen::Matrix3Xd none(3, 0);
   StepInput input{sheet.mesh.rest, none, none, none, fixed, 0.0};
   SolverSettings settings;
-  settings.tolerance = 1e-3 * std::max({sxx, syy, kSigma});
+  settings.relative_tolerance = 1e-3;
   settings.max_cg_iterations = 5000;
   Solver solver;
   SlitResult r;
@@ -93,6 +95,40 @@ TEST(MembraneSlit, OnlyTheStressNormalToTheSlitOpensIt) {
   const SlitResult across = solve_slit(options(2.5e-3, M_PI / 2), 2 * kSigma, kSigma);
   const SlitResult along = solve_slit(options(2.5e-3, 0), 2 * kSigma, kSigma);
   EXPECT_NEAR(across.fit.w_max / along.fit.w_max, 2.0, 0.1);
+}
+
+TEST(MembraneSlit, PrestressIsSigmaXxAndSigmaYyWithTheDefaultAxis) {
+  // The default axis is normal to the sheet: every face takes the documented tangent (x here),
+  // not its own first edge, so [2 sigma, sigma] is [sigma_xx, sigma_yy].
+  const Eigen::Vector3d normal = SkinMaterial{}.prestress_axis;
+  ASSERT_EQ(normal, Eigen::Vector3d::UnitZ());
+  const SlitResult across = solve_slit(options(5e-3, M_PI / 2), 2 * kSigma, kSigma, normal);
+  const SlitResult along = solve_slit(options(5e-3, 0), 2 * kSigma, kSigma, normal);
+  EXPECT_NEAR(across.fit.w_max / along.fit.w_max, 2.0, 0.1);  // 2.0 +- 5 %
+}
+
+TEST(MembraneSlit, OpeningFollowsTheNormalPrestressAtEveryAngle) {
+  // LEFM: sigma_n = sigma_xx sin^2 theta + sigma_yy cos^2 theta; the ratio to LEFM is the same
+  // at every angle (the mesh turns with the slit; the pre-stress does not).
+  const SlitResult zero = solve_slit(options(5e-3, 0), 2 * kSigma, kSigma);
+  for (const double deg : {30.0, 60.0}) {
+    const SlitResult r = solve_slit(options(5e-3, deg * M_PI / 180), 2 * kSigma, kSigma);
+    const double s = std::sin(deg * M_PI / 180), c = std::cos(deg * M_PI / 180);
+    EXPECT_NEAR(r.lefm, 4 * (2 * kSigma * s * s + kSigma * c * c) * 0.025 / 0.42e6, 1e-12);
+    EXPECT_NEAR((r.fit.w_max / r.lefm) / (zero.fit.w_max / zero.lefm), 1.0, 0.02) << deg;
+  }
+}
+
+TEST(MembraneSlit, TheRelativeToleranceMeansTheSameAtEveryStressLevel) {
+  // The opening is linear in the pre-stress: with the same relative tolerance, the ratio to
+  // LEFM is the same at 1/4 and 1x the stress (an absolute tolerance would be 4x looser, in
+  // relative terms, at the lower one).
+  const SlitResult low = solve_slit(options(5e-3), kSigma / 4, kSigma / 4);
+  const SlitResult high = solve_slit(options(5e-3), kSigma, kSigma);
+  EXPECT_LE(low.report.relative_residual, 1e-3);
+  EXPECT_LE(high.report.relative_residual, 1e-3);
+  EXPECT_NEAR(low.report.relative_residual, low.report.residual / (kSigma / 4), 1e-12);
+  EXPECT_NEAR((high.fit.w_max / high.lefm) / (low.fit.w_max / low.lefm), 1.0, 0.01);
 }
 
 TEST(MembraneSlit, NoPrestressNoOpening) {

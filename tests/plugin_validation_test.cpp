@@ -168,7 +168,8 @@ TEST(PluginValidation, EveryMaterialFieldIsRangeCheckedWithFieldValueAndRange) {
       {[](auto& m) { m.margin = -0.005; }, "material margin = -0.005 is out of range ([0, 1] m)"},
       {[nan](auto& m) { m.margin = nan; }, "material margin = nan is out of range"},
       {[](auto& m) { m.skin.youngs_modulus = -1; }, "skin material: youngs_modulus = -1"},
-      {[](auto& m) { m.solver.tolerance = -1; }, "membrane solver: tolerance = -1"},
+      {[](auto& m) { m.solver.relative_tolerance = -1; },
+       "membrane solver: relative_tolerance = -1"},
   };
   for (const Case& c : cases) {
     bullet::Material material{};

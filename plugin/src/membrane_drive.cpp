@@ -40,37 +40,48 @@ membrane::SolveReport MembraneDrive::step(
   x_.resize(3, nv);
   start_.resize(3, nv);
   predicted_.resize(3, nv);
+  carried_.resize(3, nv);
   velocity_ = (targets - previous_targets) / dt;
   fixed_.assign(fixed.begin(), fixed.end());
   for (Eigen::Index v = 0; v < nv; ++v) {
     const auto* node = static_cast<const btSoftBody::Node*>(nodes[std::size_t(v)]);
     if (!node) {  // outside Bullet: rides its target
-      x_.col(v) = start_.col(v) = predicted_.col(v) = targets.col(v);
+      x_.col(v) = start_.col(v) = predicted_.col(v) = carried_.col(v) = targets.col(v);
       fixed_[std::size_t(v)] = 1;
       continue;
     }
     predicted_.col(v) = from_bt(node->m_x);
     start_.col(v) = from_bt(node->m_q);
     if (carry && node->m_q == to_bt(solution_.col(v))) {
-      predicted_.col(v) += solution_.col(v) - start_.col(v);
+      // Bullet's prediction in float loses dt^2 g below a position's rounding (a 13 us step
+      // at 5 cm); rebuild it in double: the last step's velocity, plus what Bullet's
+      // prediction added to the velocity it left (gravity and forces, dt each).
+      const Eigen::Vector3d kick = from_bt(node->m_v) - bullet_velocity_.col(v);
+      predicted_.col(v) = solution_.col(v) + dt * (solution_velocity_.col(v) + kick);
       start_.col(v) = solution_.col(v);
     }
-    // Initial guess: the last solution carried along by its target; near the equilibrium
-    // (where it balances gravity and the membrane) this is within the tolerance already,
-    // while Bullet's prediction (+ g dt^2) is not.
-    x_.col(v) = fixed_[std::size_t(v)] ? predicted_.col(v)
-                                       : Eigen::Vector3d(start_.col(v) + dt * velocity_.col(v));
+    // Initial guesses: Bullet's prediction (momentum and gravity), and the last solution
+    // carried along by its target, which for a body at rest against gravity is the solution
+    // already (the prediction is dt^2 g off there); the solver starts from the better one.
+    x_.col(v) = predicted_.col(v);
+    carried_.col(v) = fixed_[std::size_t(v)]
+                          ? Eigen::Vector3d(predicted_.col(v))
+                          : Eigen::Vector3d(start_.col(v) + dt * velocity_.col(v));
   }
   target_normals(mesh, targets);
-  const membrane::StepInput input{targets, normals_, start_,     velocity_,
-                                  fixed_,  dt,       predicted_, masses};
+  const membrane::StepInput input{targets, normals_,   start_, velocity_, fixed_,
+                                  dt,      predicted_, masses, carried_};
   report_ = solver_.solve(model_, input, settings, x_);
   solution_ = x_;
+  solution_velocity_ = (x_ - start_) / dt;
+  bullet_velocity_.setZero(3, nv);
   for (Eigen::Index v = 0; v < nv; ++v) {
     if (fixed_[std::size_t(v)]) continue;
     auto* node = static_cast<btSoftBody::Node*>(nodes[std::size_t(v)]);
     node->m_x = to_bt(x_.col(v));
     node->m_v = (node->m_x - node->m_q) / btScalar(dt);
+    // The velocity Bullet's constraint solve will leave (kDP = 0), as it computes it.
+    bullet_velocity_.col(v) = from_bt((node->m_x - node->m_q) * (btScalar(1) / btScalar(dt)));
   }
   return report_;
 }

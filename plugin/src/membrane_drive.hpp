@@ -43,8 +43,10 @@ class MembraneDrive {
   membrane::Solver solver_;
   membrane::SolveReport report_;
   bool stale_ = true;
-  Eigen::Matrix3Xd x_, start_, predicted_, velocity_, normals_;
+  Eigen::Matrix3Xd x_, start_, predicted_, carried_, velocity_, normals_;
   Eigen::Matrix3Xd solution_;  // the last solve's result, unrounded (empty after a change)
+  // Its velocity (solution - start) / dt unrounded, and the one Bullet will leave in its nodes.
+  Eigen::Matrix3Xd solution_velocity_, bullet_velocity_;
   std::vector<std::uint8_t> fixed_;
 };
 

@@ -54,7 +54,9 @@ void SkinnedSoftBody::Impl::configure_body(btSoftBody& body, const Piece* from) 
         membrane_model() ? btScalar(0) : btScalar(material_.link_stiffness);
     if (material_.bending_stiffness > 0)
       body.appendMaterial()->m_kLST = btScalar(material_.bending_stiffness);  // material 1
-    body.m_cfg.kDP = btScalar(material_.damping);
+    // The membrane's damping is skin.attachment_damping, a viscosity in its own units; Bullet's
+    // kDP would take a fixed fraction of the momentum every substep on top of it.
+    body.m_cfg.kDP = membrane_model() ? btScalar(0) : btScalar(material_.damping);
     body.m_cfg.piterations = material_.position_iterations;
     body.getCollisionShape()->setMargin(btScalar(material_.margin));
   }

@@ -25,17 +25,31 @@ RestFrame rest_frame(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
   return f;
 }
 
-// S0 = s1 a a^T + s2 b b^T in the frame, a the axis projected onto the face's plane.
+// S0 = s1 a a^T + s2 b b^T in the frame, a the face's tangent of the axis (prestress_tangent)
+// and b = n x a.
 Eigen::Matrix2d prestress_in_frame(const SkinMaterial& m, const RestFrame& f) {
-  const Eigen::Vector3d axis = m.prestress_axis.normalized();
-  Eigen::Vector2d a(axis.dot(f.e1), axis.dot(f.e2));
-  if (a.norm() < 1e-6) a = Eigen::Vector2d::UnitX();  // axis normal to the face: first edge
-  a.normalize();
+  if (m.prestress[0] == m.prestress[1])  // isotropic: no direction needed
+    return m.prestress[0] * Eigen::Matrix2d::Identity();
+  const Eigen::Vector3d t = prestress_tangent(m.prestress_axis, f.normal);
+  const Eigen::Vector2d a(t.dot(f.e1), t.dot(f.e2));
   const Eigen::Vector2d b(-a.y(), a.x());
   return m.prestress[0] * a * a.transpose() + m.prestress[1] * b * b.transpose();
 }
 
 }  // namespace
+
+Eigen::Vector3d prestress_tangent(const Eigen::Vector3d& axis, const Eigen::Vector3d& normal) {
+  const Eigen::Vector3d a = axis.normalized(), n = normal.normalized();
+  Eigen::Vector3d t = a - a.dot(n) * n;
+  if (t.norm() > kNormalAxis) return t.normalized();
+  // The axis is the face's normal: the world axis least aligned with it, projected instead.
+  int k = 0;
+  for (int i = 1; i < 3; ++i)
+    if (std::abs(a[i]) < std::abs(a[k])) k = i;
+  const Eigen::Vector3d e = Eigen::Vector3d::Unit(k);
+  t = e - e.dot(n) * n;
+  return t.normalized();
+}
 
 void Model::build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<const mesh::Face> faces,
                   const SkinMaterial& material) {

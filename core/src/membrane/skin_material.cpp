@@ -1,5 +1,6 @@
 #include "conform/membrane/skin_material.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "range_error.hpp"
@@ -12,6 +13,11 @@ double SkinMaterial::lame_lambda() const {
 
 double SkinMaterial::lame_mu() const {
   return youngs_modulus / (2 * (1 + poisson_ratio));
+}
+
+double SkinMaterial::stress_scale() const {
+  const double prestressed = std::max(prestress[0], prestress[1]);
+  return prestressed > 0 ? prestressed : youngs_modulus;
 }
 
 void SkinMaterial::validate() const {

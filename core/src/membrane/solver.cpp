@@ -26,7 +26,8 @@ void require_cols(const Eigen::Ref<const Eigen::Matrix3Xd>& m, Eigen::Index cols
 
 void SolverSettings::validate() const {
   const RangeCheck check("membrane solver");
-  check(tolerance > 0 && std::isfinite(tolerance), "tolerance", tolerance, "> 0 Pa");
+  check(relative_tolerance > 0 && std::isfinite(relative_tolerance), "relative_tolerance",
+        relative_tolerance, "> 0 (dimensionless)");
   check(max_newton_iterations >= 1, "max_newton_iterations", max_newton_iterations, ">= 1");
   check(max_cg_iterations >= 1, "max_cg_iterations", max_cg_iterations, ">= 1");
   check(threads >= 1, "threads", threads, ">= 1");
@@ -65,6 +66,7 @@ struct Context {
   std::int64_t nv = 0, ne = 0;
   bool dynamic = false;
   int threads = 1;
+  double tolerance = 0;  // Pa: relative_tolerance x the stress scale
 
   bool fixed(std::int64_t v) const {
     return in.fixed[static_cast<std::size_t>(v)] != 0 || model.node_area(std::int32_t(v)) <= 0;
@@ -74,7 +76,9 @@ struct Context {
 
 // Phase 1: nodal terms that do not change during the solve: attachment stiffness K_i and the
 // inertia-damping weight w_i = m_i / dt^2 + c A_i / dt with its anchor
-// (m_i / dt^2 xp_i + c A_i / dt (x0_i + dt vT_i)) / w_i (kept in predicted_).
+// (m_i / dt^2 xp_i + c A_i / dt (x0_i + dt vT_i)) / w_i (kept in predicted_). The anchor is
+// built from the prediction xp, never from the initial guess: the guess only says where Newton
+// starts, the prediction carries the node's momentum and the external forces.
 void prepare_nodes(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
   Solver::Scratch& s = c.s;
   const SkinMaterial& m = c.model.material();
@@ -97,7 +101,7 @@ void prepare_nodes(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
                  damping = m.attachment_damping * area / dt, w = inertia + damping;
     s.inertia_weight_[v] = w;
     if (w > 0)
-      s.predicted_.col(v) = (inertia * x.col(v) +
+      s.predicted_.col(v) = (inertia * s.predicted_.col(v) +
                              damping * (c.in.start.col(v) + dt * c.in.target_velocities.col(v))) /
                             w;
   }
@@ -126,6 +130,28 @@ double nodal_potential(const Context& c, std::int64_t v, const Eigen::Vector3d& 
   double total = 0.5 * d.dot(c.s.node_stiffness_[static_cast<std::size_t>(v)] * d);
   if (c.dynamic) total += 0.5 * c.s.inertia_weight_[v] * (x - c.s.predicted_.col(v)).squaredNorm();
   return total;
+}
+
+// Phi at x (after Phase 1): the membrane's energy plus the free nodes' own terms.
+double total_potential(const Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+  double total = 0;
+#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel()) \
+    reduction(+ : total)
+  for (std::int64_t e = 0; e < c.ne; ++e)
+    total += c.model.elements()[std::size_t(e)].area_thickness * forces_at(c, e, x).psi;
+  for (std::int64_t v = 0; v < c.nv; ++v)
+    if (c.s.free_[std::size_t(v)]) total += nodal_potential(c, v, x.col(v));
+  return total;
+}
+
+// The initial guess: x, or the alternative where its Phi is lower (free nodes only).
+void choose_guess(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
+  if (c.in.alternative_guess.cols() != c.nv || !c.in.alternative_guess.allFinite()) return;
+  Eigen::Matrix3Xd& other = c.s.trial_;
+  other = x;
+  for (std::int64_t v = 0; v < c.nv; ++v)
+    if (c.s.free_[std::size_t(v)]) other.col(v) = c.in.alternative_guess.col(v);
+  if (total_potential(c, other) < total_potential(c, x)) x = other;
 }
 
 // Phase 3: the gradient of Phi, g = sum_e A_e t P_e beta_a (scattered element by element:
@@ -180,7 +206,7 @@ void select_active(Context& c, double worst, const Eigen::Ref<const Eigen::Matri
   if (!(c.settings.local_fraction > 0) || !std::isfinite(reach)) {
     s.active_ = s.free_;
   } else {
-    const double threshold = std::max(c.settings.tolerance, c.settings.local_fraction * worst);
+    const double threshold = std::max(c.tolerance, c.settings.local_fraction * worst);
     s.active_.assign(std::size_t(c.nv), 0);
     s.seed_of_.assign(std::size_t(c.nv), -1);
     s.reached_.clear();
@@ -482,11 +508,13 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
   require_cols(input.targets, nv, false, "targets");
   require_cols(input.target_normals, nv, true, "target_normals");
   require_cols(input.predicted, nv, true, "predicted");
+  require_cols(input.alternative_guess, nv, true, "alternative_guess");
   if (input.fixed.size() != static_cast<std::size_t>(nv))
     throw std::invalid_argument("membrane solve: fixed has " + std::to_string(input.fixed.size()) +
                                 " entries, the model has " + std::to_string(nv) + " vertices");
   Context c{model,        input,           settings, *scratch_, nv, model.element_count(),
             input.dt > 0, settings.threads};
+  c.tolerance = settings.relative_tolerance * model.material().stress_scale();
   Scratch& s = *scratch_;
   if (!input.masses.empty() && input.masses.size() != static_cast<std::size_t>(nv))
     throw std::invalid_argument("membrane solve: masses has " +
@@ -500,14 +528,16 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
   prepare_nodes(c, x);
   s.free_.resize(std::size_t(nv));
   for (Eigen::Index v = 0; v < nv; ++v) s.free_[std::size_t(v)] = !c.fixed(v);
+  choose_guess(c, x);
   s.trial_ = x;
   evaluate_elements(c, x);
   gradient_all(c, x);
   SolveReport report;
   for (;; ++report.newton_iterations) {
     report.residual = s.node_residual_.size() ? s.node_residual_.maxCoeff() : 0.0;
+    report.relative_residual = report.residual / model.material().stress_scale();
     if (report.newton_iterations == 0) report.initial_residual = report.residual;
-    if (report.residual <= settings.tolerance) {
+    if (report.residual <= c.tolerance) {
       report.converged = true;
       break;
     }

@@ -19,6 +19,17 @@
 
 namespace conform::membrane {
 
+/// Below this length of the unit axis projected onto a face's plane (the axis within about
+/// 0.06 degrees of the face's normal) the face takes prestress_tangent's fallback.
+inline constexpr double kNormalAxis = 1e-3;
+
+/// The first principal pre-stress direction of a face of unit normal n: the axis projected
+/// onto the face's plane, normalised; where the axis is the face's normal (a constant field on
+/// a closed surface must be so somewhere, e.g. at the arm's poles), the projection of the world
+/// axis (x, y, z, the first on a tie) least aligned with the axis. It depends on the axis and
+/// the normal only, never on how the face is triangulated. Unit, and normal to n.
+Eigen::Vector3d prestress_tangent(const Eigen::Vector3d& axis, const Eigen::Vector3d& normal);
+
 class Model {
  public:
   /// Builds the elements and the nodal areas. Faces whose rest area is below 1e-12 of the

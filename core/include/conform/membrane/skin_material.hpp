@@ -43,9 +43,10 @@ struct SkinMaterial {
   /// model skin-tension (Langer's) lines.
   std::array<double, 2> prestress = {80.8e3, 80.8e3};
   /// Direction field of the first principal pre-stress, in the rest (bind) space of the mesh:
-  /// a constant direction, projected onto each face's plane. Only its direction matters; unused
-  /// when the pre-stress is isotropic. Where it is normal to a face, the face takes its first
-  /// edge instead.
+  /// a constant direction, projected onto each face's plane (so the principal axes always lie
+  /// in the face). Only its direction matters; unused when the pre-stress is isotropic. Where
+  /// it is normal to a face, the face takes a documented fallback tangent that does not depend
+  /// on the triangulation (membrane::prestress_tangent in model.hpp).
   Eigen::Vector3d prestress_axis = Eigen::Vector3d::UnitZ();
   /// Tangential stiffness of the attachment to the skinned target (the subcutaneous layer in
   /// shear), Pa/m = N/m^3: force per unit area per metre of offset along the surface, >= 0
@@ -67,6 +68,9 @@ struct SkinMaterial {
   /// Plane-stress Lame constants: lambda = E nu / (1 - nu^2), mu = E / (2 (1 + nu)), Pa.
   double lame_lambda() const;
   double lame_mu() const;
+  /// The stress scale S of the solver's relative tolerance, Pa: the larger principal
+  /// pre-stress, or Young's modulus when there is none.
+  double stress_scale() const;
   /// Throws std::invalid_argument naming the first field out of its range, with its value.
   void validate() const;
 };

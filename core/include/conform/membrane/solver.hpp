@@ -11,7 +11,9 @@
 // with K_i = A_i (k_t (I - n n^T) + k_n n n^T) (n the target's unit normal; n = 0 gives k_t I),
 // m_i = rho_A A_i and A_i the node's rest area. dt <= 0 drops inertia and damping: the static
 // equilibrium. The residual is the largest nodal force imbalance per unit node area, in Pa
-// (a traction), so the tolerance means the same on every mesh.
+// (a traction), and the stopping test divides it by the material's stress scale S (the
+// pre-stress, or the modulus without one): it means the same on every mesh and at every
+// stress level.
 #pragma once
 
 #include <Eigen/Core>
@@ -35,20 +37,22 @@ enum class Preconditioner {
 };
 
 struct SolverSettings {
-  /// Stop when the largest |nodal force| / node area over the free nodes is below this, Pa.
-  /// The default, 100 Pa (1.2e-3 of skin's 80.8 kPa pre-stress), is converged for the
-  /// tear-opening wound: 4x tighter changes its largest opening by 0.007 % (res 1) and 0.007 %
-  /// (res 2), 4x looser by 0.27 % / 0.07 % (see the closing note of issue 12).
-  double tolerance = 100.0;
+  /// Stop when the largest |nodal force| / (node area x S) over the free nodes is below this,
+  /// where S is the material's stress scale (SkinMaterial::stress_scale: the larger pre-stress,
+  /// or E without one). Dimensionless, so the same setting means the same accuracy at every
+  /// stress level. The default, 1.2e-3 (97 Pa for skin's 80.8 kPa pre-stress), is converged for
+  /// the tear-opening wound: 4x tighter changes its largest opening by 0.007 % (res 1) and
+  /// 0.007 % (res 2), 4x looser by 0.27 % / 0.07 % (measured at 100 Pa).
+  double relative_tolerance = 1.2e-3;
   int max_newton_iterations = 40;
   int max_cg_iterations = 400;
   /// Each Newton system is solved until its residual is below this fraction of the gradient.
   double cg_relative_tolerance = 0.05;
   Preconditioner preconditioner = Preconditioner::symmetric_gauss_seidel;
   /// A Newton step moves only the free nodes near one whose residual exceeds
-  /// max(tolerance, local_fraction x the largest residual): after an edit the imbalance is
-  /// local, and the rest of the mesh is already in balance to far better than it. In [0, 1);
-  /// 0 moves every free node in every step. The stopping test is global either way.
+  /// max(relative_tolerance x S, local_fraction x the largest residual): after an edit the
+  /// imbalance is local, and the rest of the mesh is already in balance to far better than it. In
+  /// [0, 1); 0 moves every free node in every step. The stopping test is global either way.
   double local_fraction = 1e-2;
   /// ... where near is within local_reach decay lengths sqrt(E t / k_t) of the attachment
   /// (the distance over which it screens a load: about 4 cm for the default skin), > 0.
@@ -78,18 +82,24 @@ struct StepInput {
   std::span<const std::uint8_t> fixed;
   /// Step, s; <= 0 for the static equilibrium.
   double dt = 0;
-  /// The predicted positions xp of the inertia term (3 x #V), or empty: x's given values are
-  /// the prediction. A host that knows a better initial guess than the prediction (e.g. the last
-  /// solution moved with the targets) passes the prediction here and its guess in x.
+  /// The predicted positions xp of the inertia term (3 x #V), x0 + dt v0 + dt^2 f_ext / m:
+  /// the node's momentum, gravity and any external force act through it. Empty: x's given
+  /// values are the prediction. The initial guess (x) is a separate choice.
   Eigen::Ref<const Eigen::Matrix3Xd> predicted = no_columns();
   /// Node masses, kg (empty: rho_A times the node's rest area). A host whose edits split and
   /// conserve mass (the Bullet plugin) passes its own books, so inertia and momentum agree.
   std::span<const double> masses = {};
+  /// A second initial guess (3 x #V), or empty: Newton starts from whichever of x and this one
+  /// has the lower Phi (fixed nodes keep x's values). A host passes the prediction in x and,
+  /// here, e.g. the last solution moved with the targets, which is the better start for a body
+  /// at rest against gravity (the prediction is dt^2 g off there).
+  Eigen::Ref<const Eigen::Matrix3Xd> alternative_guess = no_columns();
 };
 
 struct SolveReport {
-  double initial_residual = 0;  // Pa, before the first Newton step
-  double residual = 0;          // Pa, at the returned positions
+  double initial_residual = 0;   // Pa, before the first Newton step
+  double residual = 0;           // Pa, at the returned positions
+  double relative_residual = 0;  // residual / S, the stopping test's measure (dimensionless)
   int newton_iterations = 0;
   int cg_iterations = 0;  // summed over the Newton iterations
   bool converged = false;
@@ -103,7 +113,7 @@ class Solver {
   Solver& operator=(Solver&&) noexcept;
 
   /// x: in, the initial guess (and the prediction xp unless StepInput::predicted is given;
-  /// fixed nodes' values are kept);
+  /// fixed nodes' values are kept; see also StepInput::alternative_guess);
   /// out, the solution. Throws std::invalid_argument on mismatched shapes.
   SolveReport solve(const Model& model, const StepInput& input, const SolverSettings& settings,
                     Eigen::Ref<Eigen::Matrix3Xd> x);

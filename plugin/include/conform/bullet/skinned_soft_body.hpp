@@ -29,8 +29,8 @@
 //     Material::kinematic_weight) are placed on their target (Bullet inverse mass 0; velocity
 //     (target − previous) / dt);
 //   membrane (the default): the free nodes take one backward-Euler step of the skin membrane
-//     attached to the targets, solved to Material::solver.tolerance (last_solve()); Bullet's
-//     links are inert (their constant c0 is 0) and its contacts act on the result;
+//     attached to the targets, solved to Material::solver.relative_tolerance (last_solve());
+//     Bullet's links are inert (their constant c0 is 0) and its contacts act on the result;
 //   bullet_links: free nodes are pulled toward their target by an implicit spring–damper per
 //     node, and every link's rest length is re-applied from our own copy (Bullet resets rest
 //     lengths to the current lengths after any edit, which would wipe pretension).
@@ -85,7 +85,9 @@ struct Material {
   /// bullet_links: Bullet's linear stiffness kLST, dimensionless in (0, 1]: the fraction of a
   /// link's length error its position solver removes per iteration.
   double link_stiffness = 0.9;
-  /// Bullet's damping kDP, dimensionless in [0, 1): fraction of velocity removed per substep.
+  /// bullet_links: Bullet's damping kDP, dimensionless in [0, 1): fraction of velocity removed
+  /// per substep. The membrane ignores it (its bodies run with kDP = 0): its damping is
+  /// skin.attachment_damping, in Pa s/m.
   double damping = 0.0;
   /// Pretension s, dimensionless in [0, 1): a link's rest length is (1 − s) × its length when
   /// the link is made (at creation, or when a topology change adds it).

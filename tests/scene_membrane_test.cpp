@@ -1,0 +1,79 @@
+// The membrane's built-in checks against closed-form mechanics, run through the `conform`
+// command: membrane-patch rings and sags as a damped oscillator on its foundation. Every
+// reference is computed here from the settings.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::json;
+
+// Runs `conform run SCENE ARGS` into a fresh folder; returns summary.json (null on failure).
+Json run(const std::string& scene, const std::string& args, const std::string& tag) {
+  const fs::path conform = fs::path(CONFORM_BINARY_DIR) / "scenes" / "conform";
+  if (!fs::exists(conform)) {
+    ADD_FAILURE() << "build the conform command first: " << conform;
+    return {};
+  }
+  const fs::path dir = fs::path(testing::TempDir()) / ("conform_membrane_scene_" + tag);
+  fs::remove_all(dir);
+  const std::string cmd = conform.string() + " run " + scene + " --out " + dir.string() +
+                          " --set outputs.plots=false " + args + " > " + dir.string() + ".log 2>&1";
+  const int rc = std::system(cmd.c_str());
+  std::ifstream log(dir.string() + ".log");
+  const std::string text((std::istreambuf_iterator<char>(log)), {});
+  if (rc != 0) {
+    ADD_FAILURE() << cmd << " failed:\n" << text;
+    return {};
+  }
+  std::ifstream in(dir / "summary.json");
+  Json summary = Json::parse(in, nullptr, false);
+  EXPECT_TRUE(summary.is_object()) << "no summary.json in " << dir;
+  return summary;
+}
+
+TEST(SceneMembranePatch, RingsAndSagsAsADampedOscillatorOnItsFoundation) {
+  // k, c and rho_A other than the defaults, so that the references are not the defaults'.
+  const double k = 2e5, c = 120, rho = 1.2, g = 9.81;
+  const Json s = run("membrane-patch",
+                     "--set material.attachment_stiffness=200000 "
+                     "--set material.attachment_damping=120 --set material.areal_density=1.2 "
+                     "--set patch.cells=4 --set duration=0.15",
+                     "patch");
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  const double f0 = std::sqrt(k / rho) / (2 * std::numbers::pi);
+  const double zeta = c / (2 * std::sqrt(k * rho));
+  const double sag = rho * g / k;
+  EXPECT_NEAR(m["reference_frequency_hz"].get<double>(), f0, 1e-9 * f0);
+  EXPECT_NEAR(m["frequency_hz"].get<double>() / f0, 1.0, 0.02);
+  EXPECT_NEAR(m["damping_ratio"].get<double>() / zeta, 1.0, 0.10);
+  EXPECT_NEAR(m["sag"].get<double>() / sag, 1.0, 0.02);
+  EXPECT_GE(m["periods_measured"].get<int>(), 3);
+  // The settings, the step the scene chose included, are echoed.
+  EXPECT_EQ(s["settings"]["material"]["attachment_stiffness"].get<double>(), k);
+  EXPECT_NEAR(s["settings"]["physics"]["dt"].get<double>(),
+              1 / (f0 * s["settings"]["patch"]["steps_per_period"].get<double>()), 1e-15);
+}
+
+TEST(SceneMembranePatch, RefusesAStepOfItsOwn) {
+  const fs::path conform = fs::path(CONFORM_BINARY_DIR) / "scenes" / "conform";
+  const std::string out = (fs::path(testing::TempDir()) / "conform_patch_dt.log").string();
+  const std::string cmd =
+      conform.string() + " run membrane-patch --steps 1 --set physics.dt=0.01 > " + out + " 2>&1";
+  EXPECT_NE(std::system(cmd.c_str()), 0);
+  std::ifstream log(out);
+  const std::string text((std::istreambuf_iterator<char>(log)), {});
+  EXPECT_NE(text.find("physics.dt"), std::string::npos) << text;
+  EXPECT_NE(text.find("steps_per_period"), std::string::npos) << text;
+}
+
+}  // namespace
