@@ -8,6 +8,10 @@ set -euo pipefail
 conform="$1"
 root="$2"
 runs="${CONFORM_CAMPAIGN_RUNS:-240}"
-if [[ -n "${CONFORM_SANITIZED:-}" ]]; then runs=60; fi  # the sanitized binary is 5-10x slower
+rss_mb=512
+if [[ -n "${CONFORM_SANITIZED:-}" ]]; then
+  runs=60       # the sanitized binary is several times slower
+  rss_mb=4096   # and ASan's shadow memory and quarantine count in its resident size
+fi
 exec /usr/bin/python3 "$root/scripts/cli_campaign.py" --conform "$conform" --runs "$runs" \
-  --seed 1 --jobs 2 --limit 30
+  --seed 1 --jobs 2 --limit 30 --max-rss-mb "$rss_mb"
