@@ -19,7 +19,8 @@ fail() { echo "sweep_kill_test: $*" >&2; exit 1; }
 # starts it with SIGINT ignored), in a process group of its own.
 set -m
 # Points that run for hours (10^7 steps of arm-track, about 0.5 ms each) unless stopped.
-long=(--steps 10000000 --set outputs.frames_every=0 --set outputs.plots=false)
+long=(--steps 10000000 --set outputs.frames_every=0 --set outputs.metrics_every=100
+      --set outputs.plots=false)
 
 # children <pid>: the pids of its child processes.
 children() { cat /proc/"$1"/task/*/children 2> /dev/null | tr ' ' '\n' | grep . || true; }

@@ -152,7 +152,7 @@ vals=$'description=a`touch BQ`;b@c,d$(touch DS)\nsystem "touch NL"\'q"'
 [[ -z "$(find "$tmp" -name BQ -o -name DS -o -name NL)" ]] || fail "a sweep value ran as a command in gnuplot"
 [[ -s "$tmp/quote/plots/rms_error_vs_arm_kp.png" ]] || { cat "$tmp/quote.log" >&2; fail "odd values kept the plot from being drawn"; }
 ! grep -q '[`$;@]' "$tmp/quote/plots/rms_error_vs_arm_kp.gp" || fail "a gnuplot script holds a raw \` \$ ; or @"
-[[ $(grep -c '^     "data/\|^plot "data/' "$tmp/quote/plots/rms_error_vs_arm_kp.gp") -eq 2 ]] ||
+[[ $(grep -c "^     'data/\|^plot 'data/" "$tmp/quote/plots/rms_error_vs_arm_kp.gp") -eq 2 ]] ||
   fail "rms_error vs arm.kp should have 2 lines (one per description)"
 # The values themselves reached the runs unchanged.
 python3 - "$tmp/quote" <<'PY' || fail "odd values did not reach the runs"
