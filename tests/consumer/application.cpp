@@ -131,7 +131,11 @@ void tear_with_rigid_scalpel(World& app, cb::Plugin& plugin, cb::SkinnedSoftBody
   std::printf("application: scalpel: %d samples, %d extended, %d held, h %.4f, message '%s'\n",
               scalpel.totals().samples, scalpel.totals().extended, scalpel.totals().held,
               scalpel.edge_length(), arm.tear() ? arm.tear()->message().c_str() : "");
-  check(scalpel.totals().extended >= 0.8 * scalpel.totals().samples,
+  // Most samples extend the tear. Since the skin keeps its momentum (inertia about the
+  // predicted positions), the opening lips near the tip ride along with the blade for a few
+  // samples, which are then held or extend nothing: 10 of 13 extended (float Bullet), against
+  // at least 80 % when every step forgot the skin's velocity.
+  check(scalpel.totals().extended >= 0.7 * scalpel.totals().samples,
         "scalpel samples that extended the tear (fraction)",
         double(scalpel.totals().extended) / std::max(1, scalpel.totals().samples));
 }
