@@ -1,6 +1,7 @@
 // The membrane's built-in checks against closed-form mechanics, run through the `conform`
-// command: membrane-patch rings and sags as a damped oscillator on its foundation. Every
-// reference is computed here from the settings.
+// command: membrane-patch rings and sags as a damped oscillator on its foundation, and
+// membrane-slit settles to the LEFM opening, its pre-stress [sigma_xx, sigma_yy] meaning that
+// with no other key. Every reference is computed here from the settings.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -74,6 +75,36 @@ TEST(SceneMembranePatch, RefusesAStepOfItsOwn) {
   const std::string text((std::istreambuf_iterator<char>(log)), {});
   EXPECT_NE(text.find("physics.dt"), std::string::npos) << text;
   EXPECT_NE(text.find("steps_per_period"), std::string::npos) << text;
+}
+
+TEST(SceneMembraneSlit, AtItsDefaultsSettlesWithin2PercentOfLefm) {
+  const Json s = run("membrane-slit", "", "slit_defaults");
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  const Json& set = s["settings"];
+  const double sigma = set["material"]["prestress"][1].get<double>();  // slit along x: sigma_yy
+  const double a = 0.5 * set["slit"]["length"].get<double>();
+  const double lefm = 4 * sigma * a / set["material"]["youngs_modulus"].get<double>();
+  EXPECT_NEAR(m["lefm_w_max"].get<double>(), lefm, 1e-12 * lefm);
+  EXPECT_NEAR(m["w_max"].get<double>() / lefm, 1.0, 0.02);
+  EXPECT_TRUE(m["settled"].get<bool>()) << m["settled_at"];
+  EXPECT_TRUE(m["converged"].get<bool>());
+}
+
+TEST(SceneMembraneSlit, PrestressIsSigmaXxAndSigmaYyWithNoOtherKey) {
+  // [2 sigma, sigma]: a slit across x (angle 90) feels 2 sigma, one along x sigma. The slit
+  // along the lower stress is the one a loose stopping test would freeze short of equilibrium.
+  const std::string common = "--set material.prestress=[800,400] --set sheet.resolution=0.005 ";
+  const Json across = run("membrane-slit", common + "--set slit.angle_deg=90", "slit_across");
+  const Json along = run("membrane-slit", common + "--set slit.angle_deg=0", "slit_along");
+  ASSERT_TRUE(across.is_object() && along.is_object());
+  // No axis key was given: the scene's own default says the sheet's x axis.
+  EXPECT_EQ(along["settings"]["material"]["prestress_axis"], Json::array({1, 0, 0}));
+  const double ratio =
+      across["metrics"]["w_max"].get<double>() / along["metrics"]["w_max"].get<double>();
+  EXPECT_NEAR(ratio, 2.0, 0.1);  // 2.0 +- 5 %
+  EXPECT_TRUE(across["metrics"]["settled"].get<bool>());
+  EXPECT_TRUE(along["metrics"]["settled"].get<bool>());
 }
 
 }  // namespace
