@@ -1,7 +1,8 @@
 // The membrane's built-in checks against closed-form mechanics, run through the `conform`
 // command: membrane-patch rings and sags as a damped oscillator on its foundation, and
 // membrane-slit settles to the LEFM opening, its pre-stress [sigma_xx, sigma_yy] meaning that
-// with no other key. Every reference is computed here from the settings.
+// with no other key; membrane-hole's drilled hole grows as Kirsch says. Every reference is
+// computed here from the settings.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -105,6 +106,38 @@ TEST(SceneMembraneSlit, PrestressIsSigmaXxAndSigmaYyWithNoOtherKey) {
   EXPECT_NEAR(ratio, 2.0, 0.1);  // 2.0 +- 5 %
   EXPECT_TRUE(across["metrics"]["settled"].get<bool>());
   EXPECT_TRUE(along["metrics"]["settled"].get<bool>());
+}
+
+// Kirsch (plane stress, small strain): a round hole made in a plate under [sxx, syy] grows its
+// semi-axes by (2 sxx - (1 - nu) syy) / E along x and the same swapped along y.
+void expect_kirsch(const Json& s, double sxx, double syy, double tolerance) {
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  const double e = s["settings"]["material"]["youngs_modulus"].get<double>();
+  const double nu = s["settings"]["material"]["poisson_ratio"].get<double>();
+  const double kx = (2 * sxx - (1 - nu) * syy) / e, ky = (2 * syy - (1 - nu) * sxx) / e;
+  EXPECT_NEAR(m["kirsch_growth_x"].get<double>(), kx, 1e-12 * std::abs(kx));
+  EXPECT_NEAR(m["kirsch_growth_y"].get<double>(), ky, 1e-12 * std::abs(ky));
+  EXPECT_NEAR(m["hole_growth_x"].get<double>() / kx, 1.0, tolerance);
+  EXPECT_NEAR(m["hole_growth_y"].get<double>() / ky, 1.0, tolerance);
+  EXPECT_TRUE(m["settled"].get<bool>());
+}
+
+TEST(SceneMembraneHole, TheDrilledHoleGrowsAsKirschSays) {
+  expect_kirsch(run("membrane-hole", "", "hole_iso"), 400, 400, 0.03);
+  expect_kirsch(run("membrane-hole", "--set material.prestress=[800,400]", "hole_aniso"), 800, 400,
+                0.03);
+}
+
+TEST(SceneMembraneHole, GrowthConvergesAsTheElementSizeHalves) {
+  const Json coarse = run("membrane-hole", "--set sheet.resolution=0.0025", "hole_h1");
+  const Json mid = run("membrane-hole", "--set sheet.resolution=0.00125", "hole_h2");
+  const Json fine = run("membrane-hole", "--set sheet.resolution=0.000625", "hole_h3");
+  ASSERT_TRUE(coarse.is_object() && mid.is_object() && fine.is_object());
+  const auto g = [](const Json& s) { return s["metrics"]["hole_growth_x"].get<double>(); };
+  const double first = std::abs(g(mid) / g(coarse) - 1), second = std::abs(g(fine) / g(mid) - 1);
+  EXPECT_LT(second, 0.01);
+  EXPECT_LT(second, first);  // the change shrinks: converging, not wandering
 }
 
 }  // namespace
