@@ -4,6 +4,13 @@
 // settles; LEFM (plane stress) gives an elliptic opening of maximum 4 sigma_n a / E, sigma_n the
 // pre-stress normal to the slit (slit_sheet.hpp). Reports w_max, the profile's R^2 against the
 // ellipse, the LEFM value and the membrane solver's residual.
+//
+// The run must reach the static equilibrium: each step stops as soon as its residual is below
+// the tolerance, so a state whose out-of-balance force per node area is below it stays put. On
+// this large, unattached sheet that frozen error is a smooth far-field displacement of order
+// tolerance x W^2 / (E t), comparable to the opening at relative_tolerance 1e-3 (a slit along
+// the lower of two pre-stresses froze 5 % short). Hence 1e-4, and `settled_at`: the last step
+// in which the solver moved the sheet.
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -24,11 +31,11 @@ constexpr const char* kMembraneSlitJson = R"json({
   "scene": "membrane-slit",
   "description": "A square sheet of skin membrane (SI units) pinned at its border and pre-stressed by material.prestress = [sigma_xx, sigma_yy] along its axes is slit through its centre by a topology change on the live Bullet soft body; it settles, and its opening is compared with linear elastic fracture mechanics (plane stress): w_max = 4 sigma_n a / E.",
   "duration": 1.0,
-  "sheet": { "width": 0.8, "resolution": 0.0025, "tip_refinement": 16 },
+  "sheet": { "width": 1.2, "resolution": 0.0025, "tip_refinement": 16 },
   "slit": { "length": 0.05, "angle_deg": 0, "at": 0.1 },
   "material": { "prestress": [400, 400], "prestress_axis": [1, 0, 0], "youngs_modulus": 420000, "poisson_ratio": 0.48,
                 "thickness": 0.0015, "attachment_stiffness": 0,
-                "attachment_normal_stiffness": 0, "wrinkling": false, "relative_tolerance": 0.001, "max_cg_iterations": 4000 },
+                "attachment_normal_stiffness": 0, "wrinkling": false, "relative_tolerance": 0.0001, "max_cg_iterations": 4000 },
   "physics": { "dt": 0.016666666666666666, "substeps": 1, "gravity": [0, 0, 0] },
   "outputs": { "metrics_every": 1, "frames_every": 0, "plots": true }
 })json";
@@ -45,7 +52,7 @@ class MembraneSlit final : public Scene {
   MembraneSlit(const Json& scene, const std::string& name, int steps_override) {
     Reader root(scene, "", resolved_);
     Reader sheet = root.object("sheet");
-    options_.width = sheet.number("width", 0.8, 1e-3, 100);
+    options_.width = sheet.number("width", 1.2, 1e-3, 100);
     options_.element_size = sheet.number("resolution", 2.5e-3, 1e-5, 1);
     options_.tip_refinement = sheet.number("tip_refinement", 16, 1, 64);
     sheet.finish();
@@ -59,7 +66,7 @@ class MembraneSlit final : public Scene {
     d.skin.prestress_axis = Eigen::Vector3d::UnitX();  // prestress = [sigma_xx, sigma_yy]
     d.skin.attachment_stiffness = 0;                   // a free membrane held by its border
     d.skin.attachment_normal_stiffness = 0;
-    d.solver.relative_tolerance = 1e-3;
+    d.solver.relative_tolerance = 1e-4;  // see the top of this file
     d.solver.max_cg_iterations = 4000;
     material_ = read_material(root, d);
     common_ = read_common(root, name, 1.0, steps_override);
@@ -108,6 +115,7 @@ class MembraneSlit final : public Scene {
       }
       const membrane::SolveReport& r = body.last_solve();
       if (slit) w_now = measure();
+      if (slit && r.newton_iterations > 0) settled_at_ = t;
       const double w_max = w_now.empty() ? 0.0 : membrane::fit_ellipse(sheet.lip_s, w_now, a).w_max;
       if (step % c.metrics_every == 0 || step == c.steps) {
         const double row[] = {t, w_max, r.residual, double(r.newton_iterations),
@@ -167,11 +175,14 @@ class MembraneSlit final : public Scene {
                     {"residual", residual},
                     {"relative_residual", relative_residual_},
                     {"converged", body_converged_},
+                    {"settled_at", settled_at_},
+                    {"settled", settled_at_ < c.steps * c.dt - 0.5 * c.dt},
                     {"nodes", sheet.mesh.vertex_count() + int(sheet.slit.new_vertices.size())},
                     {"faces", sheet.mesh.face_count()},
                     {"units",
                      "metres, pascals; residual: largest nodal force per node area, Pa; "
-                     "relative_residual: residual / the larger pre-stress"}};
+                     "relative_residual: residual / the larger pre-stress; settled_at: s, the "
+                     "last step in which the solver moved the sheet (settled: before the end)"}};
     Json timings = {{"physics_ms_per_step", physics_ms / c.steps}};
     out.finish(resolved_, metrics, timings, c.steps, c.steps * c.dt, loop_s);
     return metrics;
@@ -182,6 +193,7 @@ class MembraneSlit final : public Scene {
   double at_ = 0.1;
   bool body_converged_ = true;
   double relative_residual_ = 0;
+  double settled_at_ = 0;
 };
 
 std::unique_ptr<Scene> make_membrane_slit(const Json& scene, const std::string& name,

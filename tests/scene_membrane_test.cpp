@@ -1,6 +1,8 @@
 // The membrane's built-in checks against closed-form mechanics, run through the `conform`
-// command: membrane-patch rings and sags as a damped oscillator on its foundation. Every
-// reference is computed here from the settings.
+// command: membrane-patch rings and sags as a damped oscillator on its foundation, and
+// membrane-slit settles to the LEFM opening, its pre-stress [sigma_xx, sigma_yy] meaning that
+// with no other key; membrane-hole's drilled hole grows as Kirsch says. Every reference is
+// computed here from the settings.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -74,6 +76,68 @@ TEST(SceneMembranePatch, RefusesAStepOfItsOwn) {
   const std::string text((std::istreambuf_iterator<char>(log)), {});
   EXPECT_NE(text.find("physics.dt"), std::string::npos) << text;
   EXPECT_NE(text.find("steps_per_period"), std::string::npos) << text;
+}
+
+TEST(SceneMembraneSlit, AtItsDefaultsSettlesWithin2PercentOfLefm) {
+  const Json s = run("membrane-slit", "", "slit_defaults");
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  const Json& set = s["settings"];
+  const double sigma = set["material"]["prestress"][1].get<double>();  // slit along x: sigma_yy
+  const double a = 0.5 * set["slit"]["length"].get<double>();
+  const double lefm = 4 * sigma * a / set["material"]["youngs_modulus"].get<double>();
+  EXPECT_NEAR(m["lefm_w_max"].get<double>(), lefm, 1e-12 * lefm);
+  EXPECT_NEAR(m["w_max"].get<double>() / lefm, 1.0, 0.02);
+  EXPECT_TRUE(m["settled"].get<bool>()) << m["settled_at"];
+  EXPECT_TRUE(m["converged"].get<bool>());
+}
+
+TEST(SceneMembraneSlit, PrestressIsSigmaXxAndSigmaYyWithNoOtherKey) {
+  // [2 sigma, sigma]: a slit across x (angle 90) feels 2 sigma, one along x sigma. The slit
+  // along the lower stress is the one a loose stopping test would freeze short of equilibrium.
+  const std::string common = "--set material.prestress=[800,400] --set sheet.resolution=0.005 ";
+  const Json across = run("membrane-slit", common + "--set slit.angle_deg=90", "slit_across");
+  const Json along = run("membrane-slit", common + "--set slit.angle_deg=0", "slit_along");
+  ASSERT_TRUE(across.is_object() && along.is_object());
+  // No axis key was given: the scene's own default says the sheet's x axis.
+  EXPECT_EQ(along["settings"]["material"]["prestress_axis"], Json::array({1, 0, 0}));
+  const double ratio =
+      across["metrics"]["w_max"].get<double>() / along["metrics"]["w_max"].get<double>();
+  EXPECT_NEAR(ratio, 2.0, 0.1);  // 2.0 +- 5 %
+  EXPECT_TRUE(across["metrics"]["settled"].get<bool>());
+  EXPECT_TRUE(along["metrics"]["settled"].get<bool>());
+}
+
+// Kirsch (plane stress, small strain): a round hole made in a plate under [sxx, syy] grows its
+// semi-axes by (2 sxx - (1 - nu) syy) / E along x and the same swapped along y.
+void expect_kirsch(const Json& s, double sxx, double syy, double tolerance) {
+  ASSERT_TRUE(s.is_object());
+  const Json& m = s["metrics"];
+  const double e = s["settings"]["material"]["youngs_modulus"].get<double>();
+  const double nu = s["settings"]["material"]["poisson_ratio"].get<double>();
+  const double kx = (2 * sxx - (1 - nu) * syy) / e, ky = (2 * syy - (1 - nu) * sxx) / e;
+  EXPECT_NEAR(m["kirsch_growth_x"].get<double>(), kx, 1e-12 * std::abs(kx));
+  EXPECT_NEAR(m["kirsch_growth_y"].get<double>(), ky, 1e-12 * std::abs(ky));
+  EXPECT_NEAR(m["hole_growth_x"].get<double>() / kx, 1.0, tolerance);
+  EXPECT_NEAR(m["hole_growth_y"].get<double>() / ky, 1.0, tolerance);
+  EXPECT_TRUE(m["settled"].get<bool>());
+}
+
+TEST(SceneMembraneHole, TheDrilledHoleGrowsAsKirschSays) {
+  expect_kirsch(run("membrane-hole", "", "hole_iso"), 400, 400, 0.03);
+  expect_kirsch(run("membrane-hole", "--set material.prestress=[800,400]", "hole_aniso"), 800, 400,
+                0.03);
+}
+
+TEST(SceneMembraneHole, GrowthConvergesAsTheElementSizeHalves) {
+  const Json coarse = run("membrane-hole", "--set sheet.resolution=0.0025", "hole_h1");
+  const Json mid = run("membrane-hole", "--set sheet.resolution=0.00125", "hole_h2");
+  const Json fine = run("membrane-hole", "--set sheet.resolution=0.000625", "hole_h3");
+  ASSERT_TRUE(coarse.is_object() && mid.is_object() && fine.is_object());
+  const auto g = [](const Json& s) { return s["metrics"]["hole_growth_x"].get<double>(); };
+  const double first = std::abs(g(mid) / g(coarse) - 1), second = std::abs(g(fine) / g(mid) - 1);
+  EXPECT_LT(second, 0.01);
+  EXPECT_LT(second, first);  // the change shrinks: converging, not wandering
 }
 
 }  // namespace
