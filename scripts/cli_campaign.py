@@ -304,13 +304,10 @@ def plan(rng, box, builtins):
 
 
 def scene_name(arg, builtins):
+    """The default result's name: a built-in scene's name, or a scene file's stem."""
     if arg in builtins:
         return arg
-    try:
-        with open(arg) as f:
-            return json.load(f).get("name", "?")
-    except Exception:  # not a readable scene file: the run refuses it
-        return "?"
+    return os.path.splitext(os.path.basename(arg))[0]
 
 
 def launch(conform, argv, cwd, tag, logs):
@@ -384,7 +381,7 @@ def run_trial(conform, box, trial, index, limit, max_rss):
     before = snapshot(box.home)
     out = trial["out"]
     may = out is not None and box.may_write(out, before)
-    tag = f"{os.getpid()}-{index}"
+    tag = f"{os.getpid()}-{box.root}-{index}"
     procs = [launch(conform, trial["argv"], box.work, tag, box.root)]
     if trial["concurrent"]:
         procs.append(launch(conform, trial["argv"], box.work, tag, box.root))
@@ -530,7 +527,9 @@ def main():
     shares = [args.runs // args.jobs + (1 if k < args.runs % args.jobs else 0)
               for k in range(args.jobs)]
     total, examples = collections.Counter(), []
-    with concurrent.futures.ProcessPoolExecutor(args.jobs) as pool:
+    # Threads, not processes: a worker spends its time waiting for its runs, and anything that
+    # killed a worker would then kill the campaign itself, visibly, instead of breaking a pool.
+    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
         futures = [pool.submit(worker, args, k, n, builtins) for k, n in enumerate(shares)]
         for f in futures:
             counts, ex = f.result()
