@@ -43,6 +43,7 @@ import json
 import math
 import os
 import random
+import re
 import shutil
 import signal
 import stat
@@ -283,7 +284,9 @@ def plan(rng, box, builtins):
         trial["non_model"] = odd
     else:
         scene, odd = scene_input(rng, box, builtins)
-        argv = ["run", scene, "--steps", str(rng.choice([2, 3, 5]))]
+        argv = ["run", scene]
+        if rng.random() < 0.7:  # short runs; the others run whole, with their edits and plots
+            argv += ["--steps", str(rng.choice([2, 3, 5]))]
         if rng.random() < 0.85:
             argv.append("--no-render")
         trial["non_model"] = odd
@@ -478,6 +481,7 @@ def remove(path):
 def worker(args, worker_index, count, builtins):
     rng = random.Random(args.seed * 1000 + worker_index)
     counts = collections.Counter()
+    reasons = collections.Counter()
     examples = []
     root = tempfile.mkdtemp(prefix=f"conform-campaign-{worker_index}-")
     box = Sandbox(root, rng)
@@ -490,6 +494,8 @@ def worker(args, worker_index, count, builtins):
         defects, results = run_trial(args.conform, box, trial, i, args.limit, args.max_rss_mb)
         counts["runs"] += 1
         counts["ok" if results[0][0] == 0 else "refused"] += 1
+        if results[0][0] not in (0, None):
+            reasons[refusal_reason(results[0][4])] += 1
         counts["signalled"] += 1 if trial["signal"] else 0
         counts["concurrent"] += 1 if trial["concurrent"] else 0
         counts["peak_rss_mb_non_model"] = max(
@@ -503,7 +509,15 @@ def worker(args, worker_index, count, builtins):
                                  "stderr": results[0][4].decode(errors="replace")[-300:]})
     if not args.keep:
         shutil.rmtree(root, ignore_errors=True)
-    return counts, examples
+    return counts, examples, reasons
+
+
+def refusal_reason(stderr):
+    """The last line of a refused run's stderr, without paths and numbers: what refused it."""
+    lines = [x for x in stderr.decode(errors="replace").splitlines() if x.strip()]
+    line = lines[-1] if lines else "(nothing on stderr)"
+    line = re.sub(r"/\S*", "PATH", line)
+    return re.sub(r"[-+]?\d[\d.e+-]*", "N", line)[:90]
 
 
 def main():
@@ -526,13 +540,14 @@ def main():
     start = time.monotonic()
     shares = [args.runs // args.jobs + (1 if k < args.runs % args.jobs else 0)
               for k in range(args.jobs)]
-    total, examples = collections.Counter(), []
+    total, examples, reasons = collections.Counter(), [], collections.Counter()
     # Threads, not processes: a worker spends its time waiting for its runs, and anything that
     # killed a worker would then kill the campaign itself, visibly, instead of breaking a pool.
     with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
         futures = [pool.submit(worker, args, k, n, builtins) for k, n in enumerate(shares)]
         for f in futures:
-            counts, ex = f.result()
+            counts, ex, why = f.result()
+            reasons.update(why)
             peak = max(total["peak_rss_mb_non_model"], counts["peak_rss_mb_non_model"])
             total.update(counts)
             total["peak_rss_mb_non_model"] = peak
@@ -542,8 +557,9 @@ def main():
               **{k: total[k] for k in ["runs", "ok", "refused", "signalled", "concurrent"]},
               **{d: total[d] for d in defects},
               "peak_rss_mb_non_model": round(total["peak_rss_mb_non_model"], 1),
-              "examples": examples}
-    print(json.dumps({k: v for k, v in report.items() if k != "examples"}, indent=1))
+              "refusals": dict(reasons.most_common(25)), "examples": examples}
+    print(json.dumps({k: v for k, v in report.items() if k not in ("examples", "refusals")},
+                     indent=1))
     for e in examples[:15]:
         print(json.dumps(e))
     if args.json:
