@@ -119,6 +119,9 @@ class MembraneEdge final : public Scene {
     options_.width = decay_lengths_ * l;
     options_.fine_across = fine_across_ * l;
     options_.fine_along = fine_along_ * l;
+    if (options_.element_size > 0.05 * options_.width)
+      throw SceneError("sheet.resolution", std::to_string(options_.element_size),
+                       "at most sheet.decay_lengths x l / 20 (20 elements across the sheet)");
     if (options_.width / options_.element_size > 2e3)
       throw SceneError("sheet.resolution", std::to_string(options_.element_size),
                        "too fine for sheet.decay_lengths (more than 2000 elements across)");
@@ -268,8 +271,8 @@ Json MembraneEdge::summarise(RunOutput& out, const EdgeProfile& p,
                   {"decay_length", fitted},
                   {"foundation_retraction", u0},
                   {"foundation_decay_length", l},
-                  {"retraction_over_foundation", mean / u0},
-                  {"decay_length_over_foundation", fitted / l},
+                  {"retraction_over_foundation", u0 > 0 ? Json(mean / u0) : Json()},
+                  {"decay_length_over_foundation", fitted > 0 ? Json(fitted / l) : Json()},
                   {"plane_modulus", f.plane_modulus},
                   {"sigma_n", sigma},
                   {"cut", cut_event_},
