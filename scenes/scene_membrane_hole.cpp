@@ -16,7 +16,7 @@
 #include <Eigen/Dense>
 
 #include "conform/membrane/slit_sheet.hpp"
-#include "conform/skin/skeleton.hpp"
+#include "membrane_check.hpp"
 #include "scene.hpp"
 #include "soft_scene.hpp"
 
@@ -38,13 +38,6 @@ constexpr const char* kMembraneHoleJson = R"json({
   "physics": { "dt": 0.016666666666666666, "substeps": 1, "gravity": [0, 0, 0] },
   "outputs": { "metrics_every": 1, "frames_every": 0, "plots": false }
 })json";
-
-skin::Skeleton one_bone() {
-  skin::Skeleton s;
-  s.joints.push_back({"root", -1, skin::Versor::identity()});
-  s.bones.push_back({"root", 0, skin::Versor::identity()});
-  return s;
-}
 
 struct RimFit {
   double growth_x = 0, growth_y = 0;  // relative change of the semi-axes
@@ -122,10 +115,7 @@ class MembraneHole final : public Scene {
     const membrane::SlitSheet sheet = membrane::make_slit_sheet(options_);
     SoftWorld w(c);
     bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(sheet.mesh, one_bone(), material_);
-    std::vector<std::int32_t> border;
-    for (std::size_t v = 0; v < sheet.border.size(); ++v)
-      if (sheet.border[v]) border.push_back(std::int32_t(v));
-    body.set_pinned(border);
+    body.set_pinned(flagged_vertices(sheet.border));
     out.open_metrics({"t", "growth_x", "growth_y", "residual", "newton_iterations"});
     bool drilled = false;
     RimFit fit;
@@ -175,16 +165,12 @@ class MembraneHole final : public Scene {
                     {"growth_y_over_kirsch", ky != 0 ? fit.growth_y / ky : 0.0},
                     {"rim_vertices", rim_vertices},
                     {"rim_vertices_fitted", fit.vertices},
-                    {"residual", last.residual},
-                    {"relative_residual", last.relative_residual},
-                    {"converged", last.converged},
-                    {"settled_at", settled_at},
-                    {"settled", settled_at < c.steps * c.dt - 0.5 * c.dt},
                     {"nodes", body.vertex_count()},
                     {"units",
                      "growths: relative change of the hole's semi-axes along x and y; residual: "
                      "largest nodal force per node area, Pa; settled_at: s, the last step in "
                      "which the solver moved the sheet"}};
+    metrics.update(solver_metrics(last, settled_at, c));
     Json timings = {{"physics_ms_per_step", physics_ms / c.steps}};
     out.finish(resolved_, metrics, timings, c.steps, c.steps * c.dt, loop_s);
     return metrics;

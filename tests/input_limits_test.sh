@@ -105,6 +105,7 @@ expect_refused "key 'drill.at', value 1.1: the drill is after the last step: the
 expect_refused "key 'cut.at', value 10.0: the cut is after the last step" run cut --steps 10 --set cut.at=10 --out "$tmp/out"
 expect_refused "key 'drill.at', value 10.0: the drill is after the last step" run drill --steps 10 --set drill.at=10 --out "$tmp/out"
 expect_refused "key 'slit.at', value 10.0: the slit is after the last step" run membrane-slit --steps 10 --set slit.at=10 --out "$tmp/out"
+expect_refused "key 'cut.at', value 10.0: the cut is after the last step" run membrane-edge --steps 10 --set cut.at=10 --out "$tmp/out"
 expect_refused "key 'tear.at', value 0.5: the tear's last sample (tear.at + tear.duration) at 1 s is after the last step" \
   run tear-opening --steps 30 --out "$tmp/out"
 expect_refused "key 'pose.flex_at', value 1.5: the flex is after the last step" \
