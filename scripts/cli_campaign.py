@@ -61,7 +61,7 @@ GOOD_SCALPEL = ("t,ax,ay,az,bx,by,bz\n"
 INJECTIONS = ["r$(touch {s})", "r`touch {s}`", "r'$(touch {s})'", 'r"`touch {s}`"',
               "r;touch {s}", "r\ntouch {s}", "r && touch {s}", "r|touch {s}", "r $(touch {s}) q",
               "r\\\"$(touch {s})\\\"", "r%{s}%s", "r'\"'; touch {s}"]
-SCENES = ["membrane-slit", "cut", "drill", "tear-opening", "arm-track", "character"]
+SCENES = ["membrane-slit", "membrane-edge", "membrane-hole", "membrane-patch", "cut", "drill", "tear-opening", "arm-track", "character"]
 
 
 def snapshot(root):
