@@ -393,7 +393,9 @@ def run_trial(conform, box, trial, index, limit, max_rss):
         time.sleep(sig[1])
         if os.waitid(os.P_PID, procs[0].pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is None:
             os.kill(procs[0].pid, sig[0])  # still running (WNOWAIT: not reaped here)
+    started = time.monotonic()
     results = [wait(p, limit) for p in procs]
+    trial["seconds"] = time.monotonic() - started
     defects = []
     if any(r[2] for r in results):
         defects.append("hang")
@@ -497,6 +499,7 @@ def worker(args, worker_index, count, builtins):
         if results[0][0] not in (0, None):
             reasons[refusal_reason(results[0][4])] += 1
         counts["signalled"] += 1 if trial["signal"] else 0
+        counts["longest_run_s"] = max(counts["longest_run_s"], trial["seconds"])
         counts["concurrent"] += 1 if trial["concurrent"] else 0
         counts["peak_rss_mb_non_model"] = max(
             counts["peak_rss_mb_non_model"],
@@ -548,15 +551,16 @@ def main():
         for f in futures:
             counts, ex, why = f.result()
             reasons.update(why)
-            peak = max(total["peak_rss_mb_non_model"], counts["peak_rss_mb_non_model"])
+            maxima = {k: max(total[k], counts[k]) for k in ("peak_rss_mb_non_model", "longest_run_s")}
             total.update(counts)
-            total["peak_rss_mb_non_model"] = peak
+            total.update(maxima)
             examples += ex
     defects = ["touched", "injected", "orphan", "staging", "mismatch", "hang", "memory"]
     report = {"seed": args.seed, "seconds": round(time.monotonic() - start, 1),
               **{k: total[k] for k in ["runs", "ok", "refused", "signalled", "concurrent"]},
               **{d: total[d] for d in defects},
               "peak_rss_mb_non_model": round(total["peak_rss_mb_non_model"], 1),
+              "longest_run_s": round(total["longest_run_s"], 1),
               "refusals": dict(reasons.most_common(25)), "examples": examples}
     print(json.dumps({k: v for k, v in report.items() if k not in ("examples", "refusals")},
                      indent=1))

@@ -9,9 +9,11 @@ conform="$1"
 root="$2"
 runs="${CONFORM_CAMPAIGN_RUNS:-240}"
 rss_mb=512
+limit=30
 if [[ -n "${CONFORM_SANITIZED:-}" ]]; then
   runs=60       # the sanitized binary is several times slower
   rss_mb=4096   # and ASan's shadow memory and quarantine count in its resident size
+  limit=120     # a whole membrane-patch run takes 7 s unsanitized
 fi
 exec /usr/bin/python3 "$root/scripts/cli_campaign.py" --conform "$conform" --runs "$runs" \
-  --seed 1 --jobs 2 --limit 30 --max-rss-mb "$rss_mb"
+  --seed 1 --jobs 2 --limit "$limit" --max-rss-mb "$rss_mb"
