@@ -25,15 +25,17 @@ RestFrame rest_frame(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
   return f;
 }
 
-// S0 = s1 a a^T + s2 b b^T in the frame, a the face's tangent of the axis (prestress_tangent)
-// and b = n x a.
-Eigen::Matrix2d prestress_in_frame(const SkinMaterial& m, const RestFrame& f) {
-  if (m.prestress[0] == m.prestress[1])  // isotropic: no direction needed
-    return m.prestress[0] * Eigen::Matrix2d::Identity();
+// v1 a a^T + v2 b b^T in the frame, a the face's tangent of the axis (prestress_tangent) and
+// b = n x a: the pre-stress S0 (v = the pre-stress), or the neo-Hookean pre-stretch G (v = its
+// principal stretches).
+Eigen::Matrix2d principal_in_frame(const SkinMaterial& m, const std::array<double, 2>& v,
+                                   const RestFrame& f) {
+  if (v[0] == v[1])  // isotropic: no direction needed
+    return v[0] * Eigen::Matrix2d::Identity();
   const Eigen::Vector3d t = prestress_tangent(m.prestress_axis, f.normal);
   const Eigen::Vector2d a(t.dot(f.e1), t.dot(f.e2));
   const Eigen::Vector2d b(-a.y(), a.x());
-  return m.prestress[0] * a * a.transpose() + m.prestress[1] * b * b.transpose();
+  return v[0] * a * a.transpose() + v[1] * b * b.transpose();
 }
 
 }  // namespace
@@ -55,8 +57,11 @@ void Model::build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<cons
                   const SkinMaterial& material) {
   material.validate();
   material_ = material;
-  lambda_ = material.lame_lambda();
-  mu_ = material.lame_mu();
+  const bool nh = material.law == SkinMaterial::Law::neo_hookean;
+  lambda_ = nh ? 0.0 : material.lame_lambda();
+  mu_ = nh ? material.neo_hookean_mu() : material.lame_mu();
+  const std::array<double, 2> stretch =
+      nh ? neo_hookean_prestretch(material) : std::array<double, 2>{1.0, 1.0};
   const auto nv = static_cast<std::size_t>(rest.cols());
   elements_.clear();
   faces_.clear();
@@ -75,7 +80,9 @@ void Model::build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<cons
     }
     detail::ElementRest e;
     e.beta = frame.dm.inverse().transpose();  // columns = rows of Dm^-1
-    e.s0 = prestress_in_frame(material, frame);
+    e.s0 = principal_in_frame(material, material.prestress, frame);
+    e.law = material.law;
+    if (nh) e.g = principal_in_frame(material, stretch, frame);
     e.area_thickness = frame.area * material.thickness;
     elements_.push_back(e);
     faces_.push_back(face);

@@ -28,9 +28,18 @@ void SkinMaterial::validate() const {
           poisson_ratio, "[0, 0.5)");
   require(finite(thickness) && thickness > 0, "thickness", thickness, "> 0 m");
   require(finite(areal_density) && areal_density > 0, "areal_density", areal_density, "> 0 kg/m^2");
-  for (int i = 0; i < 2; ++i)
-    require(finite(prestress[i]) && prestress[i] >= 0 && prestress[i] < youngs_modulus,
-            i == 0 ? "prestress[0]" : "prestress[1]", prestress[i], "[0, youngs_modulus) Pa");
+  require(law == Law::stvk || law == Law::neo_hookean, "law (enumerator)", double(law),
+          "stvk or neo_hookean");
+  // The StVK law is linear in E: a pre-stress near E would be a pre-strain of order 1, outside
+  // its range. The neo-Hookean pre-stretch reaches any finite tension (prestretch.cpp).
+  for (int i = 0; i < 2; ++i) {
+    const char* field = i == 0 ? "prestress[0]" : "prestress[1]";
+    if (law == Law::stvk)
+      require(finite(prestress[i]) && prestress[i] >= 0 && prestress[i] < youngs_modulus, field,
+              prestress[i], "[0, youngs_modulus) Pa");
+    else
+      require(finite(prestress[i]) && prestress[i] >= 0, field, prestress[i], "finite and >= 0 Pa");
+  }
   require(prestress_axis.allFinite() && prestress_axis.norm() > 0, "prestress_axis (norm)",
           prestress_axis.norm(), "a finite, non-zero direction");
   require(finite(attachment_stiffness) && attachment_stiffness >= 0, "attachment_stiffness",

@@ -1,5 +1,6 @@
-// The membrane of a triangle mesh: one constant-strain, pre-stressed St Venant-Kirchhoff
-// element per face (detail/cst_kernel.hpp has the formulas), built from the REST configuration
+// The membrane of a triangle mesh: one constant-strain, pre-stressed element per face, St
+// Venant-Kirchhoff or incompressible neo-Hookean (SkinMaterial::law; detail/cst_kernel.hpp and
+// detail/neo_hookean.hpp have the formulas), built from the REST configuration
 // and the material only. Material that a topology change makes (new faces over new vertices,
 // whose rest positions are interpolated from their parents) therefore continues the material it
 // replaces: its rest state is never the current, stretched shape, and its pre-stress comes from
@@ -42,6 +43,8 @@ class Model {
   std::int32_t element_count() const { return static_cast<std::int32_t>(elements_.size()); }
   std::int32_t degenerate_faces() const { return degenerate_; }
   const SkinMaterial& material() const { return material_; }
+  /// The law's parameters, as the kernel (detail/cst_kernel.hpp) takes them, Pa: stvk the
+  /// plane-stress Lame constants; neo_hookean mu = E / 3 and lambda 0 (unused).
   double lambda() const { return lambda_; }
   double mu() const { return mu_; }
   bool wrinkling() const { return material_.wrinkling; }

@@ -19,6 +19,12 @@
 //     4e5 Pa/m. Its decay length sqrt(E t / k) is then about 4 cm.
 //   - Normal support: the body beneath resists indentation far more than shear; 100 x the
 //     tangential stiffness keeps the skin from sinking under its own curvature load sigma t / R.
+//   - Neo-Hookean law: skin is nearly incompressible (nu 0.48 above), and an incompressible
+//     solid's shear modulus is linear elasticity's mu = E / (2 (1 + nu)) at nu = 1/2, E / 3;
+//     with it the law's small-strain limit is linear elasticity with nu = 1/2, the same E.
+//     Skin's stress-strain curve is J-shaped (stiffens with stretch; Joodaki & Panzer 2018);
+//     neo-Hookean is the simplest hyperelastic law that stays valid at 10-20 % pre-strain
+//     (it stiffens mildly, far less than skin past the toe region).
 //   - Damping: not measured in these units; the default is about critical for the attachment,
 //     2 sqrt(k rho_A) = 1.6e3 Pa s/m, so that secondary motion settles in tens of milliseconds.
 #pragma once
@@ -29,6 +35,15 @@
 namespace conform::membrane {
 
 struct SkinMaterial {
+  /// The membrane's constitutive law (detail/cst_kernel.hpp, detail/neo_hookean.hpp).
+  ///   stvk: pre-stressed St Venant-Kirchhoff, S = S0 + lambda tr(E) I + 2 mu E with the
+  ///         plane-stress Lame constants of E and nu; a small-strain law (linear in E).
+  ///   neo_hookean: incompressible neo-Hookean membrane, mu = E / 3 (nu is unused: the
+  ///         thickness follows the area change), pre-stressed by a finite pre-stretch G solved
+  ///         from `prestress` (neo_hookean_prestretch); stiffens with stretch.
+  enum class Law { stvk, neo_hookean };
+  /// Default stvk.
+  Law law = Law::stvk;
   /// Young's modulus E, Pa, > 0 (skin in vivo: 0.1-1 MPa; default 0.42 MPa).
   double youngs_modulus = 0.42e6;
   /// Poisson's ratio nu of the membrane (plane stress), in [0, 0.5) (default 0.48).
@@ -39,8 +54,9 @@ struct SkinMaterial {
   double areal_density = 1.65;
   /// In-plane pre-stress of the rest configuration, Pa: its two principal values, the first
   /// along `prestress_axis` projected onto each face, the second across it in the face's plane.
-  /// Each in [0, E) (tension; default 80.8 kPa both, isotropic). Give two different values to
-  /// model skin-tension (Langer's) lines.
+  /// Each in [0, E) for stvk, finite and >= 0 for neo_hookean (whose pre-stretch reaches any
+  /// tension), Cauchy stress of the bind state (tension; default 80.8 kPa both, isotropic). Give
+  /// two different values to model skin-tension (Langer's) lines.
   std::array<double, 2> prestress = {80.8e3, 80.8e3};
   /// Direction field of the first principal pre-stress, in the rest (bind) space of the mesh:
   /// a constant direction, projected onto each face's plane (so the principal axes always lie
@@ -60,14 +76,16 @@ struct SkinMaterial {
   double attachment_damping = 1.6e3;
   /// Wrinkling: the membrane carries no compression (tension-field theory, Pipkin 1986): where
   /// a principal stress would go negative the skin buckles out of its plane instead, and the
-  /// relaxed energy of detail/tension_field.hpp is used (default true). false keeps the plain
-  /// StVK membrane, which carries compression like a plate in its plane (linear elasticity's
-  /// assumption, e.g. for comparison with LEFM).
+  /// relaxed energy of detail/tension_field.hpp (stvk) or detail/neo_hookean.hpp (neo_hookean)
+  /// is used (default true). false keeps the plain membrane, which carries compression like a plate
+  /// in its plane (linear elasticity's assumption, e.g. for comparison with LEFM).
   bool wrinkling = true;
 
   /// Plane-stress Lame constants: lambda = E nu / (1 - nu^2), mu = E / (2 (1 + nu)), Pa.
   double lame_lambda() const;
   double lame_mu() const;
+  /// The neo-Hookean law's shear modulus E / 3, Pa.
+  double neo_hookean_mu() const { return youngs_modulus / 3; }
   /// The stress scale S of the solver's relative tolerance, Pa: the larger principal
   /// pre-stress, or Young's modulus when there is none.
   double stress_scale() const;
@@ -75,7 +93,13 @@ struct SkinMaterial {
   void validate() const;
 };
 
-/// The pre-stress of an equibiaxial pre-strain eps: sigma = E eps / (1 - nu), Pa.
+/// The pre-stress of an equibiaxial pre-strain eps: sigma = E eps / (1 - nu), Pa (the StVK
+/// law's small-strain relation).
 double equibiaxial_prestress(const SkinMaterial& material, double prestrain);
+
+/// The neo-Hookean law's principal pre-stretches [l1, l2] (along the pre-stress axis and across
+/// it) whose plane-stress Cauchy stress mu (l_i^2 - 1 / (l1 l2)^2) is the material's
+/// `prestress` (to 1e-13 relative); [1, 1] without pre-stress. Depends on the material only.
+std::array<double, 2> neo_hookean_prestretch(const SkinMaterial& material);
 
 }  // namespace conform::membrane

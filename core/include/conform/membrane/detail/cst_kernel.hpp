@@ -23,12 +23,23 @@
 //   v_a = (beta_a . p) F p,  u_a = ((beta_a . m) F p + (beta_a . p) F m) / 2,
 // from dE_pp = sum_b v_b . dx_b and dE_pm = sum_b u_b . dx_b; slack elements have none. The
 // Hessian is then exact in all three regimes.
+//
+// The neo-Hookean law (ElementRest::law, detail/neo_hookean.hpp) replaces S, psi and dS by its
+// own; F, P = F S, the gradient and the geometric part dF S+ are the same. Its taut material
+// block, from dS = k [tr(Ci dE) Ci + Ci dE Ci], k = 2 mu / det Ch, Ci = C^-1, and
+// dE = sym(F^T dx_b beta_b^T), with h_a = F Ci beta_a:
+//   K_ab = A t [ (beta_a^T S+ beta_b) I + k h_a h_b^T + k/2 h_b h_a^T
+//                + k/2 (beta_a^T Ci beta_b) F Ci F^T ];
+// where wrinkled, the StVK blocks' v, u with p, m -> q, r (not unit) and the coefficients c1,
+// 2 c2 in place of (k - lambda^2 / k), 4 mu r. The StVK code paths are unchanged.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
+#include "conform/membrane/detail/neo_hookean.hpp"
 #include "conform/membrane/detail/tension_field.hpp"
+#include "conform/membrane/skin_material.hpp"
 
 namespace conform::membrane::detail {
 
@@ -37,8 +48,12 @@ using Mat32 = Eigen::Matrix<double, 3, 2>;
 /// Constant per-element data, from the rest configuration and the material.
 struct ElementRest {
   Eigen::Matrix2d beta;   // columns beta_1, beta_2 (beta_0 = -beta_1 - beta_2), 1/m
-  Eigen::Matrix2d s0;     // pre-stress in the element's frame, Pa
+  Eigen::Matrix2d s0;     // pre-stress in the element's frame, Pa (the bind state's stress)
   double area_thickness;  // A t, m^3
+  // The neo-Hookean law's pre-stretch G in the element's frame (symmetric, principal stretches
+  // along the pre-stress axes); the identity, and unused, for stvk.
+  Eigen::Matrix2d g = Eigen::Matrix2d::Identity();
+  SkinMaterial::Law law = SkinMaterial::Law::stvk;
 };
 
 inline Eigen::Vector2d beta_of(const ElementRest& e, int corner) {
@@ -93,15 +108,49 @@ struct ElementState {
   Eigen::Vector2d dir_p, dir_m;  // wrinkled: tension and compression directions (rest frame)
   double turn_ratio = 0;         // wrinkled: r
   Eigen::Matrix2d s_pos;         // S+ (for the Hessian; add_hessian_terms)
-  Eigen::Matrix3d ff;            // F F^T (shared by the element's nine Hessian blocks; ditto)
-  Eigen::Vector3d fp, fm;        // wrinkled: F p, F m (ditto)
+  Eigen::Matrix3d ff;  // F F^T (stvk), F Ci F^T (neo-Hookean, taut): shared by the blocks; ditto
+  Eigen::Vector3d fp, fm;  // wrinkled: F p, F m (neo-Hookean: F q, F r) (ditto)
+  SkinMaterial::Law law = SkinMaterial::Law::stvk;
+  NeoHookeanTerms nh;                     // neo-Hookean: Ci, det Ch (taut)
+  double wrinkle_c1 = 0, wrinkle_c2 = 0;  // neo-Hookean, wrinkled: c1, c2
 };
+
+/// The neo-Hookean element_forces (see neo_hookean.hpp): the relaxed state first, so that a
+/// collapsed element (det C = 0, infinite taut energy) that is wrinkled or slack stays finite.
+inline void neo_hookean_forces(const ElementRest& e, const Mat32& f, double mu, bool wrinkling,
+                               ElementState& s) {
+  s.law = SkinMaterial::Law::neo_hookean;
+  s.f = f;
+  const Eigen::Matrix2d c = f.transpose() * f;
+  if (wrinkling) {
+    const NeoHookeanRelaxation r = neo_hookean_relax(e.g, c, mu);
+    if (r.regime != Regime::taut) {
+      s.regime = r.regime;
+      s.stress = r.stress;
+      s.psi = r.energy;
+      s.dir_p = r.q;
+      s.dir_m = r.r;
+      s.wrinkle_c1 = r.c1;
+      s.wrinkle_c2 = r.c2;
+      s.p = s.f * s.stress;
+      return;
+    }
+  }
+  s.nh = neo_hookean_terms(e.g, c);
+  s.stress = neo_hookean_stress(e.g, s.nh, mu);
+  s.psi = neo_hookean_energy(e.g, 0.5 * (c - Eigen::Matrix2d::Identity()), s.nh, mu);
+  s.p = s.f * s.stress;
+}
 
 /// F, S, P and psi: what the energy and the gradient need; relaxed when `wrinkling`.
 inline ElementState element_forces(const ElementRest& e, const Eigen::Vector3d& x0,
                                    const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
                                    double lambda, double mu, bool wrinkling) {
-  ElementState s;
+  ElementState s;  // one object on every path (returned in place)
+  if (e.law == SkinMaterial::Law::neo_hookean) {
+    neo_hookean_forces(e, deformation_gradient(e, x0, x1, x2), mu, wrinkling, s);
+    return s;
+  }
   s.f = deformation_gradient(e, x0, x1, x2);
   const Eigen::Matrix2d strain = green_strain(s.f);
   s.stress = pk2_stress(e, strain, lambda, mu);
@@ -122,7 +171,10 @@ inline ElementState element_forces(const ElementRest& e, const Eigen::Vector3d& 
 /// S+, F F^T (and F p, F m where wrinkled) from F and S: what the Hessian blocks need.
 inline void add_hessian_terms(ElementState& s) {
   s.s_pos = positive_part(s.stress);
-  s.ff = s.f * s.f.transpose();
+  if (s.law == SkinMaterial::Law::neo_hookean && s.regime == Regime::taut)
+    s.ff = s.f * s.nh.c_inv * s.f.transpose();
+  else
+    s.ff = s.f * s.f.transpose();
   if (s.regime == Regime::wrinkled) {
     s.fp = s.f * s.dir_p;
     s.fm = s.f * s.dir_m;
@@ -160,6 +212,17 @@ inline void hessian_apply(const ElementRest& e, const ElementState& s, double la
   ds.col(0) = d1 - d0;
   ds.col(1) = d2 - d0;
   const Mat32 df = ds * e.beta.transpose();
+  const bool nh = s.law == SkinMaterial::Law::neo_hookean;
+  if (nh && s.regime == Regime::taut) {
+    const Eigen::Matrix2d m = s.f.transpose() * df;
+    const Mat32 dp =
+        e.area_thickness *
+        (df * s.s_pos + s.f * neo_hookean_tangent(s.nh, mu, 0.5 * (m + m.transpose())));
+    out1 = dp * e.beta.col(0);
+    out2 = dp * e.beta.col(1);
+    out0 = -out1 - out2;
+    return;
+  }
   if (s.regime == Regime::taut) {
     const Eigen::Matrix2d m = s.f.transpose() * df;
     const Eigen::Matrix2d de = 0.5 * (m + m.transpose());
@@ -179,11 +242,23 @@ inline void hessian_apply(const ElementRest& e, const ElementState& s, double la
                                wrinkled_corner(s, beta_of(e, 2))};
   const double de_pp = w[0].v.dot(d0) + w[1].v.dot(d1) + w[2].v.dot(d2);
   const double de_pm = w[0].u.dot(d0) + w[1].u.dot(d1) + w[2].u.dot(d2);
-  const double cv = e.area_thickness * uniaxial_modulus(lambda, mu) * de_pp,
-               cu = e.area_thickness * 4 * mu * s.turn_ratio * de_pm;
+  const double cv = nh ? e.area_thickness * s.wrinkle_c1 * de_pp
+                       : e.area_thickness * uniaxial_modulus(lambda, mu) * de_pp,
+               cu = nh ? e.area_thickness * 2 * s.wrinkle_c2 * de_pm
+                       : e.area_thickness * 4 * mu * s.turn_ratio * de_pm;
   out0 += cv * w[0].v + cu * w[0].u;
   out1 += cv * w[1].v + cu * w[1].u;
   out2 += cv * w[2].v + cu * w[2].u;
+}
+
+/// The neo-Hookean taut material block over A t (see the header):
+///   k (h_a h_b^T + h_b h_a^T / 2 + (beta_a^T Ci beta_b) F Ci F^T / 2), h_a = F Ci beta_a.
+inline Eigen::Matrix3d neo_hookean_block(const ElementState& s, double mu,
+                                         const Eigen::Vector2d& ba, const Eigen::Vector2d& bb) {
+  const double k = 2 * mu / s.nh.det_hat;
+  const Eigen::Vector2d ca = s.nh.c_inv * ba;
+  const Eigen::Vector3d ha = s.f * ca, hb = s.f * (s.nh.c_inv * bb);
+  return k * (ha * hb.transpose() + 0.5 * hb * ha.transpose() + 0.5 * ca.dot(bb) * s.ff);
 }
 
 /// Block (a, b) of the Hessian approximation (corners a, b in 0..2).
@@ -192,11 +267,16 @@ inline Eigen::Matrix3d hessian_block(const ElementRest& e, const ElementState& s
   const Eigen::Vector2d ba = beta_of(e, a), bb = beta_of(e, b);
   const Eigen::Matrix3d geometric = ba.dot(s.s_pos * bb) * Eigen::Matrix3d::Identity();
   if (s.regime == Regime::slack) return e.area_thickness * geometric;
+  const bool nh = s.law == SkinMaterial::Law::neo_hookean;
   if (s.regime == Regime::wrinkled) {
     const WrinkledCorner wa = wrinkled_corner(s, ba), wb = wrinkled_corner(s, bb);
+    if (nh)
+      return e.area_thickness * (geometric + s.wrinkle_c1 * wa.v * wb.v.transpose() +
+                                 2 * s.wrinkle_c2 * wa.u * wb.u.transpose());
     return e.area_thickness * (geometric + uniaxial_modulus(lambda, mu) * wa.v * wb.v.transpose() +
                                4 * mu * s.turn_ratio * wa.u * wb.u.transpose());
   }
+  if (nh) return e.area_thickness * (geometric + neo_hookean_block(s, mu, ba, bb));
   const Eigen::Vector3d fa = s.f * ba, fb = s.f * bb;
   return e.area_thickness * (geometric + mu * ba.dot(bb) * s.ff + mu * fb * fa.transpose() +
                              lambda * fa * fb.transpose());
@@ -207,7 +287,9 @@ inline Eigen::Matrix3d hessian_block(const ElementRest& e, const ElementState& s
 /// others are K_ba = K_ab^T, since S+ and F F^T are symmetric.
 inline void hessian_upper_blocks(const ElementRest& e, const ElementState& s, double lambda,
                                  double mu, Eigen::Matrix3d* out) {
-  if (s.regime != Regime::taut) {  // the rare relaxed elements: block by block
+  // The rare relaxed elements, and the neo-Hookean law (whose blocks are not yet shared
+  // corner by corner): block by block.
+  if (s.regime != Regime::taut || s.law == SkinMaterial::Law::neo_hookean) {
     int k = 0;
     for (int a = 0; a < 3; ++a)
       for (int b = a; b < 3; ++b, ++k) out[k] = hessian_block(e, s, lambda, mu, a, b);

@@ -1,0 +1,50 @@
+// The neo-Hookean law's pre-stretch: the principal stretches l1, l2 of the stress-free state's
+// map onto the bind state whose plane-stress Cauchy stress is the given pre-stress.
+//
+// With x_i = ln l_i the stresses are the gradient of a strictly convex function,
+//   sigma_i(x) = mu (e^{2 x_i} - e^{-2 (x1 + x2)}) = dW/dx_i,
+//   W = mu / 2 (e^{2 x1} + e^{2 x2} + e^{-2 (x1 + x2)}),
+// so the stretches minimise Phi = W - sigma . x, which is coercive for any finite sigma: its
+// Newton step is a descent direction of |dPhi/dx|^2 too, so Newton backtracking on the
+// residual's norm (which, unlike Phi, does not stall in round-off near the root) converges
+// from x = 0 (G = I). Hessian:
+//   d2W/dx2 = 2 mu [[a + c, c], [c, b + c]],  a = l1^2, b = l2^2, c = 1 / (l1 l2)^2.
+#include <Eigen/Dense>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "conform/membrane/skin_material.hpp"
+
+namespace conform::membrane {
+namespace {
+
+Eigen::Vector2d residual(const Eigen::Vector2d& x, const Eigen::Vector2d& sigma, double mu) {
+  const double c = std::exp(-2 * (x[0] + x[1]));
+  return mu * Eigen::Vector2d(std::exp(2 * x[0]) - c, std::exp(2 * x[1]) - c) - sigma;
+}
+
+}  // namespace
+
+std::array<double, 2> neo_hookean_prestretch(const SkinMaterial& material) {
+  const double mu = material.neo_hookean_mu();
+  const Eigen::Vector2d sigma(material.prestress[0], material.prestress[1]);
+  Eigen::Vector2d x = Eigen::Vector2d::Zero();
+  const double tolerance = 1e-14 * (mu + sigma.cwiseAbs().maxCoeff());
+  for (int it = 0; it < 200; ++it) {
+    const Eigen::Vector2d r = residual(x, sigma, mu);
+    if (r.cwiseAbs().maxCoeff() <= tolerance) return {std::exp(x[0]), std::exp(x[1])};
+    const double a = std::exp(2 * x[0]), b = std::exp(2 * x[1]), c = std::exp(-2 * (x[0] + x[1]));
+    Eigen::Matrix2d hessian;
+    hessian << a + c, c, c, b + c;
+    hessian *= 2 * mu;
+    const Eigen::Vector2d step = -hessian.ldlt().solve(r);
+    double t = 1;
+    while (t > 1e-6 && residual(x + t * step, sigma, mu).norm() >= r.norm()) t *= 0.5;
+    x += t * step;
+  }
+  throw std::runtime_error("neo_hookean_prestretch: Newton did not converge for prestress [" +
+                           std::to_string(sigma[0]) + ", " + std::to_string(sigma[1]) + "] Pa");
+}
+
+}  // namespace conform::membrane
