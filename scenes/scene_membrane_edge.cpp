@@ -271,14 +271,15 @@ Json MembraneEdge::summarise(RunOutput& out, const EdgeProfile& p,
                   {"decay_length", fitted},
                   {"foundation_retraction", u0},
                   {"foundation_decay_length", l},
-                  {"retraction_over_foundation", u0 > 0 ? Json(mean / u0) : Json()},
-                  {"decay_length_over_foundation", fitted > 0 ? Json(fitted / l) : Json()},
                   {"plane_modulus", f.plane_modulus},
                   {"sigma_n", sigma},
                   {"cut", cut_event_},
                   {"nodes", nodes},
                   {"faces", sheet_.mesh.face_count()},
                   {"sheet_width", options_.width}};
+  // The ratios only where there is something to compare (a summary holds finite numbers only).
+  if (u0 > 0) metrics["retraction_over_foundation"] = mean / u0;
+  if (fitted > 0) metrics["decay_length_over_foundation"] = fitted / l;
   metrics.update(solver_metrics(last, settled_at_, c));
   metrics["units"] =
       "metres, pascals; retraction: displacement of the mid-edge row away from the cut since "

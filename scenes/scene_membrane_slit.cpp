@@ -6,7 +6,7 @@
 // ellipse, the LEFM value and the membrane solver's residual. With a foundation
 // (material.attachment_stiffness k > 0) and a slit much longer than its decay length
 // l = sqrt(E'' t / k), E'' = E / (1 - nu^2), the opening tends to 2 sigma_n l / E'' instead
-// (metrics.foundation_w_max; null when k = 0).
+// (metrics.foundation_w_max; absent when k = 0: a summary holds finite numbers only).
 //
 // The run must reach the static equilibrium: each step stops as soon as its residual is below
 // the tolerance, so a state whose out-of-balance force per node area is below it stays put. On
@@ -161,15 +161,13 @@ class MembraneSlit final : public Scene {
                     {"lefm_w_max", lefm},
                     {"w_max_over_lefm", lefm > 0 ? fit.w_max / lefm : 0.0},
                     {"sigma_n", sigma_n},
-                    {"foundation_w_max", nullptr},
-                    {"w_max_over_foundation", nullptr},
                     {"nodes", sheet.mesh.vertex_count() + int(sheet.slit.new_vertices.size())},
                     {"faces", sheet.mesh.face_count()},
                     {"units",
                      "metres, pascals; residual: largest nodal force per node area, Pa; "
                      "relative_residual: residual / the larger pre-stress; settled_at: s, the "
                      "last step in which the solver moved the sheet (settled: before the end); "
-                     "foundation_w_max: null without a foundation"}};
+                     "foundation_w_max: only with a foundation"}};
     metrics.update(solver_metrics(last_, settled_at_, c));
     // On a foundation a slit much longer than l = sqrt(E'' t / k) opens at its middle as two
     // straight edges, each retracting by sigma_n l / E'' (membrane_check.hpp).
