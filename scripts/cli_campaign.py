@@ -25,7 +25,8 @@ After each run it checks, and counts as a defect:
             non-finite number in it), a failure that changed the earlier result (unless it
             was swapped in as incomplete, exit 1, with its failures in summary.json), a signalled
             run that did not exit with 128 + signal (or 0, when it finished first)
-  hang      still running after --limit seconds (killed)
+  hang      still running after --limit seconds without printing progress (killed); a run
+            still stepping then is counted as slow_valid (a mutant asking for a large mesh)
   memory    peak resident memory above --max-rss-mb on a non-model input
 
 Deterministic for a given --seed (apart from signal timing). Exit status 0 when no defect was
@@ -344,8 +345,9 @@ def wait(proc, limit):
         if time.monotonic() > deadline:
             os.killpg(proc.pid, signal.SIGKILL)
             _, status, usage = os.wait4(proc.pid, 0)
-            read_log(proc.logs[0]), read_log(proc.logs[1])
-            return None, usage.ru_maxrss / 1024, True, b"", b""
+            err = read_log(proc.logs[1])
+            read_log(proc.logs[0])
+            return None, usage.ru_maxrss / 1024, True, b"", err
         time.sleep(0.01)
 
 
@@ -397,8 +399,14 @@ def run_trial(conform, box, trial, index, limit, max_rss):
     results = [wait(p, limit) for p in procs]
     trial["seconds"] = time.monotonic() - started
     defects = []
-    if any(r[2] for r in results):
+    # A run past the limit that was still stepping (its progress lines) is a slow valid scene,
+    # e.g. a mutant asking for the 23k-node arm; one that printed no progress is a hang. Either
+    # is killed with SIGKILL, whose staging only the next run into that folder can remove.
+    killed = [r for r in results if r[2]]
+    if any(b"% (step" not in r[4] for r in killed):
         defects.append("hang")
+    elif killed:
+        trial["slow"] = True
     if trial["non_model"] and max(r[1] for r in results) > max_rss:
         defects.append("memory")
     for _ in range(200):  # children killed by the parent-death signal die asynchronously
@@ -423,8 +431,9 @@ def run_trial(conform, box, trial, index, limit, max_rss):
                if before.get(p) != after.get(p) and not (allowed and inside(p, allowed))]
     leftovers = [p for p in after if ".staging-" in os.path.basename(p)
                  or os.path.basename(p).endswith(".lock")]
-    if leftovers:
+    if leftovers and not killed:
         defects.append("staging")
+    if leftovers:
         for p in leftovers:  # counted once: the next trial starts clean
             remove(p)
     changed = [p for p in changed if p not in leftovers and not inside_any(p, leftovers)]
@@ -500,6 +509,7 @@ def worker(args, worker_index, count, builtins):
             reasons[refusal_reason(results[0][4])] += 1
         counts["signalled"] += 1 if trial["signal"] else 0
         counts["longest_run_s"] = max(counts["longest_run_s"], trial["seconds"])
+        counts["slow_valid"] += 1 if trial.get("slow") else 0
         counts["concurrent"] += 1 if trial["concurrent"] else 0
         counts["peak_rss_mb_non_model"] = max(
             counts["peak_rss_mb_non_model"],
@@ -557,7 +567,8 @@ def main():
             examples += ex
     defects = ["touched", "injected", "orphan", "staging", "mismatch", "hang", "memory"]
     report = {"seed": args.seed, "seconds": round(time.monotonic() - start, 1),
-              **{k: total[k] for k in ["runs", "ok", "refused", "signalled", "concurrent"]},
+              **{k: total[k] for k in ["runs", "ok", "refused", "signalled", "concurrent",
+                                       "slow_valid"]},
               **{d: total[d] for d in defects},
               "peak_rss_mb_non_model": round(total["peak_rss_mb_non_model"], 1),
               "longest_run_s": round(total["longest_run_s"], 1),
