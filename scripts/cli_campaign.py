@@ -562,8 +562,9 @@ def main():
             counts, ex, why = f.result()
             reasons.update(why)
             maxima = {k: max(total[k], counts[k]) for k in ("peak_rss_mb_non_model", "longest_run_s")}
-            total.update(counts)
-            total.update(maxima)
+            total.update(counts)  # adds the counts; the maxima are set below
+            for k, v in maxima.items():
+                total[k] = v
             examples += ex
     defects = ["touched", "injected", "orphan", "staging", "mismatch", "hang", "memory"]
     report = {"seed": args.seed, "seconds": round(time.monotonic() - start, 1),
