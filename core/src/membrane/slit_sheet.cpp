@@ -1,5 +1,7 @@
 #include "conform/membrane/slit_sheet.hpp"
 
+#include "conform/mesh/primitives.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -75,42 +77,14 @@ SlitSheet make_slit_sheet(const SlitSheetOptions& o) {
   SlitSheet sheet;
   sheet.slit_direction = Eigen::Vector3d(std::cos(o.slit_angle), std::sin(o.slit_angle), 0);
   sheet.slit_normal = Eigen::Vector3d(-std::sin(o.slit_angle), std::cos(o.slit_angle), 0);
+  sheet.mesh = mesh::make_grid_sheet(us, vs, sheet.slit_direction, sheet.slit_normal, o.width);
   mesh::SkinnedMesh& m = sheet.mesh;
   const std::int32_t count = nu * nv;
-  m.rest.resize(3, count);
-  m.bones.resize(mesh::kMaxInfluences, count);
-  m.weights.resize(mesh::kMaxInfluences, count);
-  m.uvs.resize(2, count);
-  m.normals.resize(3, count);
-  m.bones.setZero();
-  m.weights.setZero();
-  sheet.border.assign(static_cast<std::size_t>(count), 0);
   const auto id = [nu](std::int32_t i, std::int32_t j) { return j * nu + i; };
+  sheet.border.assign(static_cast<std::size_t>(count), 0);
   for (std::int32_t j = 0; j < nv; ++j)
-    for (std::int32_t i = 0; i < nu; ++i) {
-      const std::int32_t k = id(i, j);
-      m.rest.col(k) =
-          us[std::size_t(i)] * sheet.slit_direction + vs[std::size_t(j)] * sheet.slit_normal;
-      m.weights(0, k) = 1;
-      m.uvs.col(k) =
-          Eigen::Vector2d(us[std::size_t(i)] / o.width + 0.5, vs[std::size_t(j)] / o.width + 0.5);
-      m.normals.col(k) = Eigen::Vector3d::UnitZ();
-      sheet.border[std::size_t(k)] = i == 0 || j == 0 || i == nu - 1 || j == nv - 1;
-    }
-  m.current = m.rest;
-  // Quads split along alternating diagonals (counter-clockwise about +z: u, v right-handed).
-  for (std::int32_t j = 0; j + 1 < nv; ++j)
-    for (std::int32_t i = 0; i + 1 < nu; ++i) {
-      const std::int32_t p00 = id(i, j), p10 = id(i + 1, j), p01 = id(i, j + 1),
-                         p11 = id(i + 1, j + 1);
-      if ((i + j) % 2 == 0) {
-        m.faces.push_back({p00, p10, p11});
-        m.faces.push_back({p00, p11, p01});
-      } else {
-        m.faces.push_back({p00, p10, p01});
-        m.faces.push_back({p10, p11, p01});
-      }
-    }
+    for (std::int32_t i = 0; i < nu; ++i)
+      sheet.border[std::size_t(id(i, j))] = i == 0 || j == 0 || i == nu - 1 || j == nv - 1;
   // The slit: on the grid line v = 0, interior vertices with |u| < a.
   const auto j0 = static_cast<std::int32_t>(std::find(vs.begin(), vs.end(), 0.0) - vs.begin());
   mesh::TopologyChange& c = sheet.slit;

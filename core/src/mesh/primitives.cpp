@@ -1,5 +1,6 @@
 #include "conform/mesh/primitives.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -97,6 +98,44 @@ SkinnedMesh make_icosphere(int subdivisions, double radius) {
     m.uvs(1, i) = 0.5 + std::asin(std::clamp(n.z(), -1.0, 1.0)) / std::numbers::pi;
   }
   assign_height_weights(m, -0.3 * radius, 0.3 * radius, 0.25 * radius);
+  return m;
+}
+
+SkinnedMesh make_grid_sheet(const std::vector<double>& us, const std::vector<double>& vs,
+                            const Eigen::Vector3d& u_axis, const Eigen::Vector3d& v_axis,
+                            double uv_size) {
+  const auto nu = static_cast<std::int32_t>(us.size()), nv = static_cast<std::int32_t>(vs.size());
+  const std::int32_t count = nu * nv;
+  SkinnedMesh m;
+  m.rest.resize(3, count);
+  m.bones.setZero(kMaxInfluences, count);
+  m.weights.setZero(kMaxInfluences, count);
+  m.uvs.resize(2, count);
+  m.normals.resize(3, count);
+  const Eigen::Vector3d normal = u_axis.cross(v_axis).normalized();
+  const auto id = [nu](std::int32_t i, std::int32_t j) { return j * nu + i; };
+  for (std::int32_t j = 0; j < nv; ++j)
+    for (std::int32_t i = 0; i < nu; ++i) {
+      const std::int32_t k = id(i, j);
+      const double u = us[std::size_t(i)], v = vs[std::size_t(j)];
+      m.rest.col(k) = u * u_axis + v * v_axis;
+      m.weights(0, k) = 1;
+      m.uvs.col(k) = Eigen::Vector2d(u / uv_size + 0.5, v / uv_size + 0.5);
+      m.normals.col(k) = normal;
+    }
+  m.current = m.rest;
+  for (std::int32_t j = 0; j + 1 < nv; ++j)
+    for (std::int32_t i = 0; i + 1 < nu; ++i) {
+      const std::int32_t p00 = id(i, j), p10 = id(i + 1, j), p01 = id(i, j + 1),
+                         p11 = id(i + 1, j + 1);
+      if ((i + j) % 2 == 0) {
+        m.faces.push_back({p00, p10, p11});
+        m.faces.push_back({p00, p11, p01});
+      } else {
+        m.faces.push_back({p00, p10, p01});
+        m.faces.push_back({p10, p11, p01});
+      }
+    }
   return m;
 }
 
