@@ -45,6 +45,22 @@ std::string spinning_smd() {
   return s;
 }
 
+// Imports `p` isolated under the default budget and expects its refusal to name the file and
+// to say the import "did not finish within <budget_prefix>".
+void expect_stopped_by_budget(const fs::path& p, const std::string& budget_prefix) {
+  conform::io::ImportOptions o;
+  o.isolate = true;
+  try {
+    conform::io::import_model(p, o);
+    ADD_FAILURE() << p << " imported";
+  } catch (const ImportError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(what.rfind(p.string(), 0), 0u) << what;
+    EXPECT_EQ(e.file(), p.string());
+    EXPECT_NE(what.find("did not finish within " + budget_prefix), std::string::npos) << what;
+  }
+}
+
 }  // namespace
 
 TEST(ImportBudget, SmallFileGetsTheFixedPartAndLargeFilesTheirRate) {
@@ -69,20 +85,8 @@ TEST(ImportBudget, TinyCorruptFilesAreRefusedNamingTheFile) {
   ASSERT_EQ(kTruncatedBinaryPly.size(), 33u);
   ASSERT_EQ(spinning_smd().size(), 221u);
   for (const fs::path& p : {write_file("truncated_header.ply", kTruncatedBinaryPly),
-                            write_file("spins.smd", spinning_smd())}) {
-    conform::io::ImportOptions o;
-    o.isolate = true;
-    try {
-      conform::io::import_model(p, o);
-      ADD_FAILURE() << p << " imported";
-    } catch (const ImportError& e) {
-      const std::string what = e.what();
-      EXPECT_EQ(what.rfind(p.string(), 0), 0u) << what;
-      EXPECT_EQ(e.file(), p.string());
-      // Stopped by the small budget of its size (the flat cap said "within 30 s").
-      EXPECT_NE(what.find("did not finish within 2.0"), std::string::npos) << what;
-    }
-  }
+                            write_file("spins.smd", spinning_smd())})
+    expect_stopped_by_budget(p, "2.0");  // the flat cap said "within 30 s"
   fs::remove_all(scratch());
 }
 
@@ -99,17 +103,7 @@ TEST(ImportBudget, SlowColladaMutantIsRefusedByTheBudgetOfItsSize) {
   const auto at = text.find(from);
   ASSERT_NE(at, std::string::npos);
   text.replace(at, from.size(), "<vertex_weights count=\"100000000\">");
-  const fs::path p = write_file("weights.dae", text);
-  conform::io::ImportOptions o;
-  o.isolate = true;
-  try {
-    conform::io::import_model(p, o);
-    ADD_FAILURE() << p << " imported";
-  } catch (const ImportError& e) {
-    const std::string what = e.what();
-    EXPECT_EQ(what.rfind(p.string(), 0), 0u) << what;
-    EXPECT_NE(what.find("did not finish within 2.1"), std::string::npos) << what;
-  }
+  expect_stopped_by_budget(write_file("weights.dae", text), "2.1");
   fs::remove_all(scratch());
 }
 
