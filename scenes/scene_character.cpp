@@ -12,6 +12,7 @@
 #include "conform/io/import.hpp"
 #include "conform/io/weld_model.hpp"
 #include "event_time.hpp"
+#include "model_frame.hpp"
 #include "scene.hpp"
 #include "soft_scene.hpp"
 
@@ -25,7 +26,7 @@ constexpr const char* kCharacterJson = R"json({
   "seed": 1,
   "duration": 1.56,
   "model": { "file": "/usr/share/assimp/models/FBX/huesitos.fbx", "animation": "0",
-             "units_per_metre": 100, "weld": true },
+             "units_per_metre": 100, "up": "y", "weld": true },
   "material": { "link_stiffness": 0.02, "target_stiffness": 2000, "target_damping": 20,
                 "kinematic_weight": 0.95, "damping": 0.01 },
   "cut": { "at": 0.3, "point": [0.68, 0.39, 0.305], "normal": [1, 0, -0.625], "cap": true },
@@ -40,7 +41,7 @@ constexpr const char* kCharacterJson = R"json({
 
 using Clock = std::chrono::steady_clock;
 
-// The fastest node after the first step and the fastest target motion over it (model units/s).
+// The fastest node after the first step and the fastest target motion over it (m/s).
 struct FirstStep {
   double node_speed = 0, target_speed = 0;
 };
@@ -75,7 +76,8 @@ class Character final : public Scene {
     if (file_.rfind("arm", 0) != 0 && !std::filesystem::exists(file_))
       model.fail("file", Json(file_), "no such file");
     animation_ = model.text("animation", "0");
-    units_ = model.number("units_per_metre", 1, 1e-6, 1e6);
+    frame_.units_per_metre = model.number("units_per_metre", 1, 1e-6, 1e6);
+    frame_.up = model.text("up", "y", {"y", "z"});
     import_.strict_weights = model.boolean("strict_weights", false);
     weld_ = model.boolean("weld", true);
     // Seam copies whose bone weights differ: welded with their mean weights (closed seams), or
@@ -111,6 +113,9 @@ class Character final : public Scene {
     CommonSettings c = common_;
     require_edits_before_end(c);
     io::SkinnedModel model = io::load_model(file_, import_);
+    // From here on the model is in metres, Y up: Bullet, gravity, the margin and every
+    // length reported are in metres whatever the file's units.
+    to_scene_frame(model, frame_);
     const Eigen::Matrix3Xd file_rest = model.mesh.rest;
     const mesh::WeldResult weld =
         weld_ ? io::weld_model(model, import_.weld_options) : mesh::WeldResult{};
@@ -121,11 +126,8 @@ class Character final : public Scene {
       throw std::runtime_error(file_ + ": no animation '" + animation_ + "' (" +
                                std::to_string(model.animations.size()) + " animations)");
     const skin::Animation& animation = model.animations[static_cast<std::size_t>(a)];
-    c.gravity *= units_;  // metres → the model's units
-    bullet::Material material = material_;
-    material.margin *= units_;
     SoftWorld w(c);
-    bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(model, material);
+    bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(model, material_);
     // No loop: this animation's last key is not its first, and the wrap would be a jump.
     body.play(animation, skin::Blend::log, false);
     // The first substep would start the body on the animation's first pose by itself; the
@@ -139,8 +141,7 @@ class Character final : public Scene {
       start_targets[static_cast<std::size_t>(v)] = body.target(v);
     std::int32_t kinematic = 0;
     for (std::int32_t v = 0; v < body.vertex_count(); ++v) kinematic += body.kinematic(v);
-    out.open_metrics({"t", "offset_mean", "offset_max", "offset_mean_m", "offset_max_m",
-                      "seam_gap_rel", "pieces", "nodes"});
+    out.open_metrics({"t", "offset_mean_m", "offset_max_m", "seam_gap_rel", "pieces", "nodes"});
     RunState s;
     out.frame("character", 0, body.mesh());
     const auto loop_start = Clock::now();
@@ -205,14 +206,8 @@ class Character final : public Scene {
     const double gap = seams.measure(body) / bind.diagonal();
     s.worst_seam_gap = std::max(s.worst_seam_gap, gap);
     if (step % c.metrics_every == 0 || step == c.steps) {
-      const double row[] = {step * c.dt,
-                            o.mean,
-                            o.max,
-                            o.mean / units_,
-                            o.max / units_,
-                            gap,
-                            double(body.piece_count()),
-                            double(body.vertex_count())};
+      const double row[] = {
+          step * c.dt, o.mean, o.max, gap, double(body.piece_count()), double(body.vertex_count())};
       out.metrics().row(row);
     }
   }
@@ -225,17 +220,21 @@ class Character final : public Scene {
               {"animation", animation.name},
               // The first step's fastest node against the fastest motion of the skinned targets
               // over that step (the animation itself), m/s.
-              {"first_step_max_node_speed_m_s", s.first.node_speed / units_},
-              {"first_step_max_target_speed_m_s", s.first.target_speed / units_},
+              {"first_step_max_node_speed_m_s", s.first.node_speed},
+              {"first_step_max_target_speed_m_s", s.first.target_speed},
               {"animation_duration_s", animation.duration()},
               {"vertices", model.mesh.vertex_count()},
               {"faces", model.mesh.face_count()},
               {"bones", model.skeleton.bone_count()},
+              // The bind pose's bounding box in the scene's frame (metres, Y up).
+              {"bind_pose_lo_m", {bind.lo.x(), bind.lo.y(), bind.lo.z()}},
+              {"bind_pose_size_m",
+               {bind.hi.x() - bind.lo.x(), bind.hi.y() - bind.lo.y(), bind.hi.z() - bind.lo.z()}},
               {"kinematic_nodes", kinematic},
               {"final_vertices", body.vertex_count()},
               {"pieces", body.piece_count()},
-              {"secondary_motion_mean_m", s.mean_offset_sum / c.steps / units_},
-              {"secondary_motion_max_m", s.worst_offset / units_},
+              {"secondary_motion_mean_m", s.mean_offset_sum / c.steps},
+              {"secondary_motion_max_m", s.worst_offset},
               {"seams",
                {{"welded", weld_},
                 {"file_vertices_at_seams", seams.file_vertices()},
@@ -247,10 +246,11 @@ class Character final : public Scene {
                 // The largest distance, over the run, between body vertices standing for file
                 // vertices at one rest position, relative to the bind pose's bounding-box diagonal.
                 {"max_gap_rel", s.worst_seam_gap},
-                {"diagonal", bind.diagonal()}}},
+                {"diagonal_m", bind.diagonal()}}},
               {"units",
-               "secondary motion = distance of a node from its CGA-skinned target, "
-               "metres (model units / units_per_metre); edits in model units"}};
+               "metres, seconds (the file's coordinates / model.units_per_metre, turned Y up "
+               "when model.up is z); secondary motion = distance of a node from its "
+               "CGA-skinned target; edit placements are fractions of the bind pose's box"}};
     if (cut_.enabled) m["cut"] = s.cut;
     if (tear_.enabled) m["tear"] = s.tear;
     if (drill_.enabled) m["drill"] = s.drill;
@@ -276,7 +276,7 @@ class Character final : public Scene {
   std::string file_, animation_;
   io::ImportOptions import_;
   bool weld_ = true;
-  double units_ = 1;
+  ModelFrame frame_;
   bullet::Material material_;
   CutEdit cut_;
   TearEdit tear_;
