@@ -121,15 +121,14 @@ class Character final : public Scene {
         weld_ ? io::weld_model(model, import_.weld_options) : mesh::WeldResult{};
     for (const auto& w : model.warnings)
       std::cerr << "warning: " << model.source << ": " << w << "\n";
-    const int a = model.find_animation(animation_);
-    if (a < 0)
-      throw std::runtime_error(file_ + ": no animation '" + animation_ + "' (" +
-                               std::to_string(model.animations.size()) + " animations)");
-    const skin::Animation& animation = model.animations[static_cast<std::size_t>(a)];
+    const skin::Animation* animation = chosen_animation(model);
     SoftWorld w(c);
     bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(model, material_);
     // No loop: this animation's last key is not its first, and the wrap would be a jump.
-    body.play(animation, skin::Blend::log, false);
+    if (animation)
+      body.play(*animation, skin::Blend::log, false);
+    else
+      body.set_pose(skin::Pose::rest(model.skeleton));  // the bind pose; physics still acts
     // The first substep would start the body on the animation's first pose by itself; the
     // snap does it now, so that frame 0 and the start targets below are of that pose.
     body.snap_to_pose();
@@ -174,6 +173,23 @@ class Character final : public Scene {
   }
 
  private:
+  // The animation played, or none (the bind pose): when model.animation is "none", or by
+  // itself, with a note, when the file has no animation at all (a static or posed model).
+  const skin::Animation* chosen_animation(const io::SkinnedModel& model) const {
+    if (animation_ == "none") return nullptr;
+    if (model.animations.empty() && animation_ == "0") {
+      std::cerr << "note: " << file_
+                << " has no animation: it plays its bind pose (model.animation = \"none\")\n";
+      return nullptr;
+    }
+    const int a = model.find_animation(animation_);
+    if (a < 0)
+      throw std::runtime_error(file_ + ": no animation '" + animation_ + "' (" +
+                               std::to_string(model.animations.size()) +
+                               " animations; \"none\" plays the bind pose)");
+    return &model.animations[static_cast<std::size_t>(a)];
+  }
+
   // Every enabled edit happens before the last step (else it would be skipped unsaid).
   void require_edits_before_end(const CommonSettings& c) const {
     if (cut_.enabled) require_before_end(c, "cut.at", cut_.at, "the cut", cut_.at);
@@ -213,16 +229,16 @@ class Character final : public Scene {
   }
 
   Json summarize(const bullet::SkinnedSoftBody& body, const io::SkinnedModel& model,
-                 const skin::Animation& animation, const mesh::WeldResult& weld,
+                 const skin::Animation* animation, const mesh::WeldResult& weld,
                  const SeamGap& seams, const BindPose& bind, std::int32_t kinematic,
                  const CommonSettings& c, const RunState& s) const {
     Json m = {{"model", file_},
-              {"animation", animation.name},
+              {"animation", animation ? animation->name : "none (bind pose)"},
               // The first step's fastest node against the fastest motion of the skinned targets
               // over that step (the animation itself), m/s.
               {"first_step_max_node_speed_m_s", s.first.node_speed},
               {"first_step_max_target_speed_m_s", s.first.target_speed},
-              {"animation_duration_s", animation.duration()},
+              {"animation_duration_s", animation ? animation->duration() : 0.0},
               {"vertices", model.mesh.vertex_count()},
               {"faces", model.mesh.face_count()},
               {"bones", model.skeleton.bone_count()},

@@ -1,5 +1,6 @@
 // The character scene on a user's own model: its units (every figure in metres whatever the
-// file's units) and its up axis. Each run is the `conform` command on a small model.
+// file's units), its up axis, and a model without animation (its bind pose plays). Each run is the
+// `conform` command on a small model.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -136,6 +137,23 @@ TEST(CharacterUpAxis, AZUpModelStandsOnItsFeetAlongY) {
   EXPECT_NE(x.rc, 0);
   EXPECT_NE(x.log.find("model.up"), std::string::npos) << x.log;
   EXPECT_NE(x.log.find("\"x\""), std::string::npos) << x.log;
+}
+
+TEST(CharacterBindPose, AModelWithoutAnimationPlaysItsBindPose) {
+  const std::string file = kModels + "MD5/SimpleCube.md5mesh";
+  if (!fs::exists(file)) GTEST_SKIP() << "no assimp-testmodels";
+  const Outcome r = run("--set model.file=" + file, "bind_pose");
+  ASSERT_EQ(r.rc, 0) << r.log;
+  EXPECT_NE(r.log.find("no animation"), std::string::npos) << r.log;  // the note
+  EXPECT_EQ(r.summary["metrics"]["animation"], "none (bind pose)");
+  // Asked for: an animated model held in its bind pose.
+  const Outcome held = run("--steps 30 --set model.animation=none" + kNoEdits, "bind_pose_asked");
+  ASSERT_EQ(held.rc, 0) << held.log;
+  EXPECT_EQ(held.summary["metrics"]["animation_duration_s"].get<double>(), 0);
+  // An unknown animation is still refused.
+  const Outcome bad = run("--steps 2 --set model.animation=walk" + kNoEdits, "bind_pose_bad");
+  EXPECT_NE(bad.rc, 0);
+  EXPECT_NE(bad.log.find("no animation 'walk'"), std::string::npos) << bad.log;
 }
 
 }  // namespace
