@@ -71,6 +71,10 @@ struct CutEdit {
   Eigen::Vector3d point{0.68, 0.39, 0.305};  // box fractions
   Eigen::Vector3d normal{1, 0, -0.625};      // rest space
   bool cap = true;
+  /// Which sections of the plane's meeting with the body are cut (mesh/cut_region.hpp):
+  /// `nearest` the one nearest `seed` (a limb, not every limb the plane crosses), else all.
+  enum class Region { everywhere, nearest } region = Region::nearest;
+  Eigen::Vector3d seed{0.68, 0.39, 0.305};  // box fractions (cut.seed, by default `point`)
 };
 struct TearEdit {
   bool enabled = true;

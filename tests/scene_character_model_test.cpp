@@ -1,6 +1,6 @@
 // The character scene on a user's own model: its units (every figure in metres whatever the
-// file's units), its up axis, and a model without animation (its bind pose plays). Each run is the
-// `conform` command on a small model.
+// file's units), its up axis, a model without animation (its bind pose plays) and a cut
+// bounded to the aimed limb. Each run is the `conform` command on a small model.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -154,6 +154,38 @@ TEST(CharacterBindPose, AModelWithoutAnimationPlaysItsBindPose) {
   const Outcome bad = run("--steps 2 --set model.animation=walk" + kNoEdits, "bind_pose_bad");
   EXPECT_NE(bad.rc, 0);
   EXPECT_NE(bad.log.find("no animation 'walk'"), std::string::npos) << bad.log;
+}
+
+TEST(CharacterCutRegion, AnArmCutSeversTheArmOnly) {
+  // A level plane through BCN_Epileptic.X's right forearm (it hangs by the body) also crosses
+  // the left arm and the torso's layers: unbounded, it cuts them all; bounded to the section
+  // nearest the cut's point (the default, cut.region = "nearest"), one loop, around the arm.
+  const std::string file = kModels + "X/BCN_Epileptic.X";
+  if (!fs::exists(file)) GTEST_SKIP() << "no assimp-testmodels";
+  const std::string args =
+      "--set duration=0.35 --set tear.enabled=false "
+      "--set drill.enabled=false --set model.file=" +
+      file + " --set cut.point=[0.05,0.65,0.5] --set cut.normal=[0,1,0]";
+  const Outcome bounded = run(args, "region_nearest");
+  ASSERT_EQ(bounded.rc, 0) << bounded.log;
+  const Json& cut = bounded.summary["metrics"]["cut"];
+  EXPECT_EQ(cut["region"], "nearest");
+  EXPECT_EQ(cut["bone"], "B_ForeArm_Right");
+  EXPECT_EQ(cut["kept_sections"].get<int>(), 1) << cut;
+  EXPECT_GT(cut["sections"].get<int>(), 1) << cut;
+  EXPECT_EQ(cut["loops"].get<int>(), 1) << cut;
+  EXPECT_EQ(cut["capped_loops"].get<int>(), 1) << cut;
+  EXPECT_EQ(cut["new_pieces"].get<int>(), 1) << cut;
+  const Outcome plane = run(args + " --set cut.region=everywhere", "region_everywhere");
+  ASSERT_EQ(plane.rc, 0) << plane.log;
+  const Json& all = plane.summary["metrics"]["cut"];
+  EXPECT_EQ(all["region"], "everywhere");
+  EXPECT_GT(all["loops"].get<int>(), 3) << all;
+  EXPECT_GT(all["new_pieces"].get<int>(), 3) << all;
+  // Another name is refused, naming it.
+  const Outcome bad = run("--steps 2" + kNoEdits + "--set cut.region=arm", "region_bad");
+  EXPECT_NE(bad.rc, 0);
+  EXPECT_NE(bad.log.find("cut.region"), std::string::npos) << bad.log;
 }
 
 }  // namespace
