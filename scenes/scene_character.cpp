@@ -22,11 +22,11 @@ namespace {
 // The built-in scene `character`, the defaults of this kind (`conform scenes --show character`).
 constexpr const char* kCharacterJson = R"json({
   "scene": "character",
-  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body (nodes close to one bone ride it, blended regions follow their skinned targets softly) and, while it plays, its arm is cut off with a capped cut, its flank torn by a scalpel stroke and its base drilled through with a tube; the welded seams are measured for gaps. Units: the model is brought to metres, Y up, at import: model.units_per_metre file units make a metre, model.up (y or z) is the file's up axis (z is turned to y). Edits are placed on the bind pose: cut.point, cut.seed, tear.from, tear.to, drill.tip and drill.base as fractions of its bounding box, tear.blade_a and tear.blade_b as fractions of its size, drill.radius as a fraction of its diagonal, cut.normal in its axes (after model.up); material.margin is in metres, physics.gravity in m/s^2; every length in summary.json is in metres. model.animation = none plays the bind pose (what a model without animation does). cut.region = nearest cuts only the section of the plane nearest cut.seed (by default cut.point), everywhere the unbounded plane.",
+  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body (nodes close to one bone ride it, blended regions follow their skinned targets softly) and, while it plays, its arm is cut off with a capped cut, its flank torn by a scalpel stroke and its base drilled through with a tube; the welded seams are measured for gaps. Units: the model is brought to metres, Y up, at import: model.units_per_metre file units make a metre (\"file\": the unit the file states, FBX's UnitScaleFactor, else 100), model.up (y or z) is the file's up axis (z is turned to y). Edits are placed on the bind pose: cut.point, cut.seed, tear.from, tear.to, drill.tip and drill.base as fractions of its bounding box, tear.blade_a and tear.blade_b as fractions of its size, drill.radius as a fraction of its diagonal, cut.normal in its axes (after model.up); material.margin is in metres, physics.gravity in m/s^2; every length in summary.json is in metres. model.animation = none plays the bind pose (what a model without animation does). cut.region = nearest cuts only the section of the plane nearest cut.seed (by default cut.point), everywhere the unbounded plane.",
   "seed": 1,
   "duration": 1.56,
   "model": { "file": "/usr/share/assimp/models/FBX/huesitos.fbx", "animation": "0",
-             "units_per_metre": 100, "up": "y", "weld": true },
+             "units_per_metre": "file", "up": "y", "weld": true },
   "material": { "link_stiffness": 0.02, "target_stiffness": 2000, "target_damping": 20,
                 "kinematic_weight": 0.95, "damping": 0.01 },
   "cut": { "at": 0.3, "point": [0.68, 0.39, 0.305], "normal": [1, 0, -0.625], "cap": true,
@@ -77,7 +77,11 @@ class Character final : public Scene {
     if (file_.rfind("arm", 0) != 0 && !std::filesystem::exists(file_))
       model.fail("file", Json(file_), "no such file");
     animation_ = model.text("animation", "0");
-    frame_.units_per_metre = model.number("units_per_metre", 1, 1e-6, 1e6);
+    // A number, or "file" (also when absent): the unit the file states (FBX), else 100.
+    if (model.is_text("units_per_metre") || !model.has("units_per_metre"))
+      model.text("units_per_metre", "file", {"file"});
+    else
+      frame_.units_per_metre = model.number("units_per_metre", 1, 1e-6, 1e6);
     frame_.up = model.text("up", "y", {"y", "z"});
     import_.strict_weights = model.boolean("strict_weights", false);
     weld_ = model.boolean("weld", true);
@@ -116,7 +120,7 @@ class Character final : public Scene {
     io::SkinnedModel model = io::load_model(file_, import_);
     // From here on the model is in metres, Y up: Bullet, gravity, the margin and every
     // length reported are in metres whatever the file's units.
-    to_scene_frame(model, frame_);
+    to_scene_frame(model, frame_of(model));
     const Eigen::Matrix3Xd file_rest = model.mesh.rest;
     const mesh::WeldResult weld =
         weld_ ? io::weld_model(model, import_.weld_options) : mesh::WeldResult{};
@@ -174,6 +178,27 @@ class Character final : public Scene {
   }
 
  private:
+  // The file's units: model.units_per_metre, or the unit the file states (FBX's
+  // UnitScaleFactor, in centimetres), or, when it states none, 100 (the scene's former default).
+  ModelFrame frame_of(const io::SkinnedModel& model) {
+    ModelFrame frame = frame_;
+    if (frame_.units_per_metre > 0) {
+      units_source_ = "model.units_per_metre";
+    } else if (model.unit_scale_cm > 0) {
+      frame.units_per_metre = 100 / model.unit_scale_cm;
+      units_source_ = "the file's UnitScaleFactor (" + Json(model.unit_scale_cm).dump() + " cm)";
+      if (!(frame.units_per_metre >= 1e-6 && frame.units_per_metre <= 1e6))
+        throw std::runtime_error(file_ + ": its UnitScaleFactor " +
+                                 Json(model.unit_scale_cm).dump() +
+                                 " cm is out of range; set model.units_per_metre");
+    } else {
+      frame.units_per_metre = 100;
+      units_source_ = "assumed: the file states no unit (set model.units_per_metre)";
+    }
+    units_per_metre_ = frame.units_per_metre;
+    return frame;
+  }
+
   // The animation played, or none (the bind pose): when model.animation is "none", or by
   // itself, with a note, when the file has no animation at all (a static or posed model).
   const skin::Animation* chosen_animation(const io::SkinnedModel& model) const {
@@ -234,6 +259,8 @@ class Character final : public Scene {
                  const SeamGap& seams, const BindPose& bind, std::int32_t kinematic,
                  const CommonSettings& c, const RunState& s) const {
     Json m = {{"model", file_},
+              {"units_per_metre", units_per_metre_},
+              {"units_per_metre_from", units_source_},
               {"animation", animation ? animation->name : "none (bind pose)"},
               // The first step's fastest node against the fastest motion of the skinned targets
               // over that step (the animation itself), m/s.
@@ -293,7 +320,9 @@ class Character final : public Scene {
   std::string file_, animation_;
   io::ImportOptions import_;
   bool weld_ = true;
-  ModelFrame frame_;
+  ModelFrame frame_{0, "y"};  // units_per_metre 0: from the file
+  double units_per_metre_ = 0;
+  std::string units_source_;
   bullet::Material material_;
   CutEdit cut_;
   TearEdit tear_;

@@ -92,6 +92,27 @@ TEST(CharacterUnits, AModelInMillimetresRuns) {
   EXPECT_EQ(r.rc, 0) << r.log;
 }
 
+TEST(CharacterUnits, TheUnitTheFileStatesIsTheDefault) {
+  // FBX files state their unit (UnitScaleFactor, centimetres per unit): huesitos.fbx's is 1 cm.
+  // An .X file states none: 100 units per metre, as the scene always assumed.
+  if (!fs::exists(kModels + "FBX/huesitos.fbx")) GTEST_SKIP() << "no assimp-testmodels";
+  const Outcome fbx = run("--steps 2" + kNoEdits, "units_fbx");
+  ASSERT_EQ(fbx.rc, 0) << fbx.log;
+  EXPECT_EQ(fbx.summary["metrics"]["units_per_metre"].get<double>(), 100);
+  EXPECT_NE(
+      fbx.summary["metrics"]["units_per_metre_from"].get<std::string>().find("UnitScaleFactor"),
+      std::string::npos);
+  const Outcome x =
+      run("--steps 2" + kNoEdits + "--set model.file=" + kModels + "X/anim_test.x", "units_x");
+  ASSERT_EQ(x.rc, 0) << x.log;
+  EXPECT_EQ(x.summary["metrics"]["units_per_metre"].get<double>(), 100);
+  EXPECT_NE(x.summary["metrics"]["units_per_metre_from"].get<std::string>().find("assumed"),
+            std::string::npos);
+  const Outcome set = run("--steps 2" + kNoEdits + "--set model.units_per_metre=250", "units_set");
+  ASSERT_EQ(set.rc, 0) << set.log;
+  EXPECT_EQ(set.summary["metrics"]["units_per_metre"].get<double>(), 250);
+}
+
 TEST(CharacterUnits, ScaledCopiesGiveTheSameMetresAtTheirUnits) {
   if (!fs::exists(kModels + "glTF2/simple_skin/simple_skin.gltf"))
     GTEST_SKIP() << "no assimp-testmodels";
@@ -104,6 +125,7 @@ TEST(CharacterUnits, ScaledCopiesGiveTheSameMetresAtTheirUnits) {
     ASSERT_EQ(r.rc, 0) << r.log;
     Json m = r.summary["metrics"];
     m.erase("model");
+    m.erase("units_per_metre");  // the one figure in file units
     EXPECT_GT(m["secondary_motion_max_m"].get<double>(), 0);
     if (reference.is_null())
       reference = m;
