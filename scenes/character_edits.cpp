@@ -68,6 +68,16 @@ const std::string& BoneCarrier::bone_name() const {
   return body_.skeleton().bones[static_cast<std::size_t>(bone_)].name;
 }
 
+namespace {
+// cut.region: "nearest" (the section nearest cut.seed, by default cut.point) or "everywhere"
+// (the unbounded plane).
+void read_region(Reader& r, CutEdit& e) {
+  const std::string region = r.text("region", "nearest", {"nearest", "everywhere"});
+  e.region = region == "nearest" ? CutEdit::Region::nearest : CutEdit::Region::everywhere;
+  e.seed = r.vec3("seed", e.point);
+}
+}  // namespace
+
 CutEdit read_cut(Reader& root) {
   Reader r = root.object("cut");
   CutEdit e, d;
@@ -78,6 +88,7 @@ CutEdit read_cut(Reader& root) {
   e.normal = r.vec3("normal", d.normal);
   if (!(e.normal.norm() > 1e-9)) r.fail("normal", Json{0, 0, 0}, "must not be zero");
   e.cap = r.boolean("cap", d.cap);
+  read_region(r, e);
   r.finish();
   return e;
 }
@@ -123,6 +134,9 @@ Json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, const CutEdi
   const std::int32_t before = body.vertex_count(), pieces_before = body.piece_count();
   mesh::CutOptions options;
   options.cap = edit.cap;
+  // The seed is carried by the cut's bone, like the plane, so it stays on the aimed limb.
+  if (edit.region == CutEdit::Region::nearest)
+    options.region = mesh::CutRegion::seed(carrier.point(bind.point(edit.seed)));
   const auto plane =
       cga::Plane<double>::from_normal_point(carrier.direction(p, edit.normal), carrier.point(p));
   const mesh::CutResult r = body.cut(plane, options);
@@ -133,7 +147,13 @@ Json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, const CutEdi
                 {"loops", r.loops},
                 {"capped_loops", r.capped_loops},
                 {"cap_faces", r.cap_faces},
-                {"new_pieces", body.piece_count() - pieces_before}};
+                {"new_pieces", body.piece_count() - pieces_before},
+                {"region", edit.region == CutEdit::Region::nearest ? "nearest" : "everywhere"}};
+  if (edit.region == CutEdit::Region::nearest) {
+    event["seed"] = {edit.seed.x(), edit.seed.y(), edit.seed.z()};
+    event["sections"] = r.sections;  // where the plane meets the body
+    event["kept_sections"] = r.kept_sections;
+  }
   if (!r.message.empty()) event["message"] = r.message;
   return event;
 }

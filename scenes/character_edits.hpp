@@ -71,6 +71,10 @@ struct CutEdit {
   Eigen::Vector3d point{0.68, 0.39, 0.305};  // box fractions
   Eigen::Vector3d normal{1, 0, -0.625};      // rest space
   bool cap = true;
+  /// Which sections of the plane's meeting with the body are cut (mesh/cut_region.hpp):
+  /// `nearest` the one nearest `seed` (a limb, not every limb the plane crosses), else all.
+  enum class Region { everywhere, nearest } region = Region::nearest;
+  Eigen::Vector3d seed{0.68, 0.39, 0.305};  // box fractions (cut.seed, by default `point`)
 };
 struct TearEdit {
   bool enabled = true;
@@ -113,7 +117,7 @@ class TearRun {
   const TearEdit edit_;
   const BindPose& bind_;
   int next_ = 0, extended_ = 0;
-  double tip_to_blade_ = -1;  // the tip's distance from the last sample's blade, model units
+  double tip_to_blade_ = -1;  // the tip's distance from the last sample's blade, m
   std::string bone_;
 };
 
@@ -131,7 +135,8 @@ class SeamGap {
   /// `file_rest`: the rest positions as the file gives them (before welding); `vertex_map`:
   /// file vertex → body vertex (the weld's; identity when empty).
   SeamGap(const Eigen::Matrix3Xd& file_rest, std::span<const std::int32_t> vertex_map);
-  /// The largest gap now (vertices that left Bullet, e.g. drilled out, aside), model units.
+  /// The largest gap now (vertices that left Bullet, e.g. drilled out, aside), in the
+  /// body's units (metres in the character scene).
   double measure(const bullet::SkinnedSoftBody& body) const;
   std::int32_t positions() const { return static_cast<std::int32_t>(starts_.size()) - 1; }
   std::int32_t file_vertices() const { return file_vertices_; }

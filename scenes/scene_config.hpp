@@ -49,6 +49,8 @@ class Reader {
   bool is_boolean(const std::string& key) const {
     return has(key) && object_->at(key).is_boolean();
   }
+  /// True when the key is present and a string (a key that is a number or a name).
+  bool is_text(const std::string& key) const { return has(key) && object_->at(key).is_string(); }
   double number(const std::string& key, double fallback, double min = -kInf, double max = kInf);
   /// Like number() but the key must be present.
   double required_number(const std::string& key, double min = -kInf, double max = kInf);

@@ -588,6 +588,17 @@ unsigned import_flags() {
 
 namespace {
 
+// The file's unit in centimetres, when it states one (FBX: UnitScaleFactor, a float or a
+// double by assimp version); 0 otherwise, or when the value is not a positive finite number.
+double unit_scale_cm(const aiScene& scene) {
+  if (!scene.mMetaData) return 0;
+  double d = 0;
+  float f = 0;
+  if (!scene.mMetaData->Get("UnitScaleFactor", d) && scene.mMetaData->Get("UnitScaleFactor", f))
+    d = f;
+  return std::isfinite(d) && d > 0 ? d : 0;
+}
+
 // The import itself, in this process.
 SkinnedModel import_here(const std::string& file, const ImportOptions& options) {
   Assimp::Importer importer;
@@ -603,6 +614,7 @@ SkinnedModel import_here(const std::string& file, const ImportOptions& options) 
 
   Builder b{file, scene, options};
   b.model.source = file;
+  b.model.unit_scale_cm = unit_scale_cm(*scene);
   b.walk(scene->mRootNode);
   b.meshes();
   b.animations();

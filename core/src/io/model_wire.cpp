@@ -1,5 +1,6 @@
 #include "conform/io/model_wire.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
@@ -8,7 +9,7 @@
 namespace conform::io {
 namespace {
 
-constexpr std::uint32_t kMagic = 0x434d5731;  // "CMW1"
+constexpr std::uint32_t kMagic = 0x434d5732;  // "CMW2": with the unit scale
 
 class Writer {
  public:
@@ -226,6 +227,7 @@ std::string encode_model(const SkinnedModel& model) {
   Writer w;
   w.pod(kMagic);
   w.str(model.source);
+  w.pod(model.unit_scale_cm);
   write_mesh(w, model.mesh);
   w.pods(model.influences.offsets);
   w.pods(model.influences.bones);
@@ -245,6 +247,9 @@ SkinnedModel decode_model(std::string_view bytes) {
   if (r.pod<std::uint32_t>() != kMagic) Reader::fail("not a model message");
   SkinnedModel model;
   model.source = r.str();
+  model.unit_scale_cm = r.pod<double>();
+  if (!(std::isfinite(model.unit_scale_cm) && model.unit_scale_cm >= 0))
+    Reader::fail("a unit scale that is not a finite number >= 0");
   read_mesh(r, model.mesh);
   model.influences.offsets = r.pods<std::int32_t>();
   model.influences.bones = r.pods<std::int32_t>();

@@ -40,6 +40,9 @@ struct SkinnedModel {
   std::vector<skin::Animation> animations;
   std::vector<MeshInfo> meshes;
   std::vector<std::string> warnings;  // e.g. weights normalized, transforms approximated
+  /// Centimetres per file unit as the file states it (FBX's UnitScaleFactor metadata), so that
+  /// a user need not know the file's units; 0 when the file states none.
+  double unit_scale_cm = 0;
 
   /// Index of the animation named `name_or_index`, or with that index; −1 if none.
   int find_animation(const std::string& name_or_index) const;
