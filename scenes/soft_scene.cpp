@@ -1,9 +1,11 @@
 #include "soft_scene.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "conform/bullet/convert.hpp"
 
@@ -45,6 +47,22 @@ bool finite_nodes(const bullet::SkinnedSoftBody& body) {
   return true;
 }
 
+// An enumerated key: its value's name among `names` (fallback's name by default).
+template <typename Enum, std::size_t N>
+Enum choose(Reader& r, const std::string& key,
+            const std::array<std::pair<Enum, const char*>, N>& names, Enum fallback) {
+  std::string fallback_name = names[0].second, list;
+  for (const auto& [value, name] : names) {
+    list += (list.empty() ? "" : ", ") + std::string(name);
+    if (value == fallback) fallback_name = name;
+  }
+  const std::string chosen = r.text(key, fallback_name);
+  for (const auto& [value, name] : names)
+    if (chosen == name) return value;
+  r.fail(key, Json(chosen), "must be one of: " + list);
+  return fallback;
+}
+
 // The membrane's fields (SI units; skin_material.hpp has their ranges and sources).
 void read_skin(Reader& r, const bullet::Material& d, bullet::Material& m) {
   membrane::SkinMaterial& k = m.skin;
@@ -55,6 +73,12 @@ void read_skin(Reader& r, const bullet::Material& d, bullet::Material& m) {
   k.areal_density = r.number("areal_density", e.areal_density, 1e-6, 1e4);
   k.prestress = r.pair("prestress", e.prestress, 0, 0.5 * k.youngs_modulus);
   k.prestress_axis = r.vec3("prestress_axis", e.prestress_axis);
+  using Field = membrane::SkinMaterial::DirectionField;
+  const std::array<std::pair<Field, const char*>, 3> fields = {
+      {{Field::axis, "axis"},
+       {Field::along_bones, "along-bones"},
+       {Field::around_bones, "around-bones"}}};
+  k.prestress_field = choose(r, "prestress_field", fields, e.prestress_field);
   if (!(k.prestress_axis.norm() > 0))
     r.fail("prestress_axis", Json::array({0, 0, 0}), "must be a non-zero direction");
   k.attachment_stiffness = r.number("attachment_stiffness", e.attachment_stiffness, 0, 1e12);
@@ -63,9 +87,13 @@ void read_skin(Reader& r, const bullet::Material& d, bullet::Material& m) {
   k.attachment_damping = r.number("attachment_damping", e.attachment_damping, 0, 1e9);
   k.wrinkling = r.boolean("wrinkling", e.wrinkling);
   using Law = membrane::SkinMaterial::Law;
-  const std::string law = r.text("law", e.law == Law::neo_hookean ? "neo-hookean" : "stvk",
-                                 {"stvk", "neo-hookean"});
-  k.law = law == "neo-hookean" ? Law::neo_hookean : Law::stvk;
+  const std::array<std::pair<Law, const char*>, 3> laws = {
+      {{Law::stvk, "stvk"},
+       {Law::neo_hookean, "neo-hookean"},
+       {Law::fibre_reinforced, "fibre-reinforced"}}};
+  k.law = choose(r, "law", laws, e.law);
+  k.fibre_stiffness = r.number("fibre_stiffness", e.fibre_stiffness, 0, 1e10);
+  k.fibre_nonlinearity = r.number("fibre_nonlinearity", e.fibre_nonlinearity, 1e-6, 100);
   if (r.has("tolerance"))
     r.fail("tolerance", r.number("tolerance", 0),
            "was an absolute residual in Pa; the membrane's stopping test is now "

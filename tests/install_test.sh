@@ -27,7 +27,7 @@ done
   fail "public headers are missing from the prefix"
 details="$(cd "$include" && find . -path '*/detail/*' ! -path './cga/detail/product_table.hpp' \
   ! -path './membrane/detail/cst_kernel.hpp' ! -path './membrane/detail/tension_field.hpp' \
-  ! -path './membrane/detail/neo_hookean.hpp')"
+  ! -path './membrane/detail/neo_hookean.hpp' ! -path './membrane/detail/fibre.hpp')"
 [[ -z "$details" ]] || fail "detail headers are installed: $details"
 
 # A project of the other Bullet precision is refused at configure time, with a message that

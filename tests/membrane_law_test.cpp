@@ -64,20 +64,33 @@ TEST(MembraneLaw, NeoHookeanEquibiaxialStretchGivesTheClosedForm) {
   }
 }
 
+// Uniaxial stretch l along x (along_x) or y with a free width: the width w that makes the
+// energy stationary in it (the other Cauchy stress 0, by bisection: it grows with the width),
+// and the Cauchy stress along the stretch there.
+struct Uniaxial {
+  double width = 0, stress = 0;
+};
+Uniaxial uniaxial(const Model& model, const Triangle& t, double l, bool along_x) {
+  const auto at = [&](double w) {
+    return cauchy(model, along_x ? stretched(t, l, w) : stretched(t, w, l));
+  };
+  const int across = along_x ? 1 : 0, along = 1 - across;
+  double lo = 0.3, hi = 1.0;
+  for (int i = 0; i < 200 && hi - lo > 1e-15; ++i) {
+    const double w = 0.5 * (lo + hi);
+    (at(w)(across, across) > 0 ? hi : lo) = w;
+  }
+  const double w = 0.5 * (lo + hi);
+  return {w, at(w)(along, along)};
+}
+
 TEST(MembraneLaw, NeoHookeanUniaxialStretchWithAFreeWidthGivesTheClosedForm) {
   const Triangle t = right_triangle();
   Model model;
   model.build(t.rest, t.faces, unstressed(Law::neo_hookean));
   const double mu = model.mu();
   for (const double l : {1.05, 1.2, 1.35, 1.5}) {
-    // The free width makes the energy stationary in it: sigma_yy = 0, by bisection (sigma_yy
-    // grows with the width).
-    double lo = 0.3, hi = 1.0;
-    for (int i = 0; i < 200 && hi - lo > 1e-15; ++i) {
-      const double w = 0.5 * (lo + hi);
-      (cauchy(model, stretched(t, l, w))(1, 1) > 0 ? hi : lo) = w;
-    }
-    const double w = 0.5 * (lo + hi);
+    const double w = uniaxial(model, t, l, true).width;
     EXPECT_NEAR(w, 1 / std::sqrt(l), 1e-9) << l;   // the natural width l^-1/2
     const double expected = mu * (l * l - 1 / l);  // sigma = mu (l^2 - 1/l)
     EXPECT_NEAR(cauchy(model, stretched(t, l, w))(0, 0), expected, 1e-6 * expected) << l;
@@ -210,7 +223,7 @@ detail::Regime check_derivatives(const Triangle& t, const SkinMaterial& material
 
 TEST(MembraneLaw, BothLawsDerivativesMatchFiniteDifferencesWhenTaut) {
   std::mt19937 rng(5);
-  for (const Law law : {Law::stvk, Law::neo_hookean})
+  for (const Law law : {Law::stvk, Law::neo_hookean, Law::fibre_reinforced})
     for (int trial = 0; trial < 10; ++trial) {
       const double s = 1.02 + 0.05 * trial;  // up to 47 % stretch
       const Triangle t = random_triangle(rng, s, s);
@@ -225,17 +238,104 @@ TEST(MembraneLaw, BothLawsDerivativesMatchFiniteDifferencesWhenTaut) {
 TEST(MembraneLaw, NeoHookeanRelaxedDerivativesMatchFiniteDifferences) {
   std::mt19937 rng(9);
   int wrinkled = 0, slack = 0;
-  for (int trial = 0; trial < 20; ++trial) {
-    // Stretched along x, squeezed across: wrinkled; squeezed both ways: slack.
+  for (int trial = 0; trial < 40; ++trial) {
+    // Stretched along x, squeezed across: wrinkled; squeezed both ways: slack. The
+    // fibre-reinforced law's fibres (along (0.3, 1, 0.2)) add their term in both regimes.
     const bool squeeze_both = trial % 2;
+    const Law law = trial % 4 < 2 ? Law::neo_hookean : Law::fibre_reinforced;
     const Triangle t = random_triangle(rng, squeeze_both ? 0.8 : 1.3, 0.6);
-    SCOPED_TRACE(testing::Message() << "trial " << trial);
-    const detail::Regime r = check_derivatives(t, prestressed(Law::neo_hookean, true));
+    SCOPED_TRACE(testing::Message() << "trial " << trial << " law " << int(law));
+    const detail::Regime r = check_derivatives(t, prestressed(law, true));
     wrinkled += r == detail::Regime::wrinkled;
     slack += r == detail::Regime::slack;
   }
-  EXPECT_GE(wrinkled, 5);
-  EXPECT_GE(slack, 5);
+  EXPECT_GE(wrinkled, 10);
+  EXPECT_GE(slack, 10);
+}
+
+// ---- The fibre-reinforced law ----------------------------------------------------------------
+
+SkinMaterial fibres_along_x() {
+  SkinMaterial m = unstressed(Law::fibre_reinforced);
+  m.prestress_axis = Eigen::Vector3d::UnitX();
+  return m;
+}
+
+TEST(MembraneLaw, FibreReinforcedUniaxialStretchGivesTheClosedFormAlongAndAcross) {
+  const Triangle t = right_triangle();
+  Model model;
+  const SkinMaterial m = fibres_along_x();
+  model.build(t.rest, t.faces, m);
+  const double mu = model.mu(), k1 = m.fibre_stiffness, k2 = m.fibre_nonlinearity;
+  for (const double l : {1.05, 1.2, 1.35, 1.5}) {
+    // Along the fibres: the matrix's mu (l^2 - 1/l) plus the fibres' 2 psi_f'(e) l^2,
+    // e = l^2 - 1, psi_f' = k1 e exp(k2 e^2); the width is still l^-1/2 (the fibres carry no
+    // stress across).
+    const Uniaxial along = uniaxial(model, t, l, true);
+    const double e = l * l - 1;
+    const double expected = mu * (l * l - 1 / l) + 2 * k1 * e * std::exp(k2 * e * e) * l * l;
+    EXPECT_NEAR(along.width, 1 / std::sqrt(l), 1e-9) << l;
+    EXPECT_NEAR(along.stress, expected, 1e-6 * expected) << l;
+    // Across: the fibres shorten (width < 1) and carry nothing: the matrix alone.
+    const Uniaxial across = uniaxial(model, t, l, false);
+    EXPECT_NEAR(across.stress, mu * (l * l - 1 / l), 1e-6 * mu * l * l) << l;
+  }
+}
+
+TEST(MembraneLaw, FibreReinforcedDefaultsReproduceTheirTwoSourceRatios) {
+  // skin_material.hpp: k1 makes the small-strain modulus along the fibres 1.76 x the modulus
+  // across (112.5 / 63.8 MPa), k2 makes the nominal stress's tangent along the fibres at 54 %
+  // strain 70.6 x its initial value (83.3 / 1.18 MPa). Measured on the element by uniaxial
+  // stretches with a free width.
+  const Triangle t = right_triangle();
+  Model model;
+  model.build(t.rest, t.faces, fibres_along_x());
+  const auto nominal = [&](double l, bool along_x) {
+    return uniaxial(model, t, l, along_x).stress / l;
+  };
+  const auto tangent = [&](double l, bool along_x) {
+    const double h = 1e-5;
+    return (nominal(l + h, along_x) - nominal(l - h, along_x)) / (2 * h);
+  };
+  EXPECT_NEAR(tangent(1 + 1e-5, true) / tangent(1 + 1e-5, false), 112.5 / 63.8, 0.01);
+  EXPECT_NEAR(tangent(1.54, true) / tangent(1 + 1e-5, true) / (83.3 / 1.18), 1, 0.01);
+}
+
+TEST(MembraneLaw, FibreReinforcedPrestretchReproducesThePrestress) {
+  const Triangle t = right_triangle();
+  for (const std::array<double, 2> sigma :
+       {std::array<double, 2>{80.8e3, 80.8e3}, std::array<double, 2>{60e3, 20e3},
+        std::array<double, 2>{0, 150e3}, std::array<double, 2>{840e3, 10e3}}) {
+    SkinMaterial m = unstressed(Law::fibre_reinforced);
+    m.prestress = sigma;
+    m.prestress_axis = Eigen::Vector3d(1, 1, 0);  // 45 degrees in the element's frame
+    const std::array<double, 2> l = neo_hookean_prestretch(m);
+    Model model;
+    model.build(t.rest, t.faces, m);
+    const Eigen::Vector2d a = Eigen::Vector2d(1, 1).normalized(), b(-a.y(), a.x());
+    const Eigen::Matrix2d expected = sigma[0] * a * a.transpose() + sigma[1] * b * b.transpose();
+    const double scale = m.neo_hookean_mu() + sigma[0] + sigma[1];
+    EXPECT_LT((cauchy(model, t.rest) - expected).cwiseAbs().maxCoeff(), 1e-12 * scale);
+    // The fibres take part of the tension along the axis: less stretch there than the
+    // neo-Hookean matrix alone needs for the same pre-stress.
+    SkinMaterial matrix = m;
+    matrix.law = Law::neo_hookean;
+    if (sigma[0] > 0) {
+      EXPECT_LT(l[0], neo_hookean_prestretch(matrix)[0]);
+    }
+  }
+}
+
+TEST(MembraneLaw, FibreParametersAreValidated) {
+  SkinMaterial m = fibres_along_x();
+  EXPECT_NO_THROW(m.validate());
+  m.fibre_stiffness = -1;
+  EXPECT_THROW(m.validate(), std::invalid_argument);
+  m = fibres_along_x();
+  m.fibre_nonlinearity = 0;
+  EXPECT_THROW(m.validate(), std::invalid_argument);
+  m.fibre_nonlinearity = std::nan("");
+  EXPECT_THROW(m.validate(), std::invalid_argument);
 }
 
 }  // namespace

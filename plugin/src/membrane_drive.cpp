@@ -3,6 +3,7 @@
 #include <BulletSoftBody/btSoftBody.h>
 
 #include "conform/bullet/convert.hpp"
+#include "conform/skin/limb_axes.hpp"
 
 namespace conform::bullet {
 
@@ -34,7 +35,9 @@ membrane::SolveReport MembraneDrive::step(
   // contact) continues from Bullet's position.
   const bool carry = !stale_ && solution_.cols() == nv;
   if (stale_ || model_.vertex_count() != nv) {
-    model_.build(mesh.rest, mesh.faces, material);
+    const bool by_bones = material.prestress_field != membrane::SkinMaterial::DirectionField::axis;
+    if (by_bones) limb_axes_ = skin::vertex_limb_axes(mesh, bone_axes_);
+    model_.build(mesh.rest, mesh.faces, material, by_bones ? &limb_axes_ : nullptr);
     stale_ = false;
   }
   x_.resize(3, nv);

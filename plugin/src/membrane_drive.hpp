@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "conform/membrane/model.hpp"
@@ -25,6 +26,9 @@ class MembraneDrive {
  public:
   /// The mesh's faces or rest positions changed: the model is rebuilt at the next step.
   void invalidate() { stale_ = true; }
+  /// The skeleton's bone axes (skin::bone_axes), which the along_bones and around_bones
+  /// pre-stress fields follow through each vertex's weights.
+  void set_bone_axes(std::vector<Eigen::Vector3d> axes) { bone_axes_ = std::move(axes); }
   /// One substep. `nodes` per vertex (null for a vertex outside Bullet); `fixed` per vertex
   /// (kinematic or pinned: left where Bullet put them); masses, targets and previous targets
   /// per vertex.
@@ -43,6 +47,8 @@ class MembraneDrive {
   membrane::Solver solver_;
   membrane::SolveReport report_;
   bool stale_ = true;
+  std::vector<Eigen::Vector3d> bone_axes_;
+  Eigen::Matrix3Xd limb_axes_;  // per vertex, at the last rebuild
   Eigen::Matrix3Xd x_, start_, predicted_, carried_, velocity_, normals_;
   Eigen::Matrix3Xd solution_;  // the last solve's result, unrounded (empty after a change)
   // Its velocity (solution - start) / dt unrounded, and the one Bullet will leave in its nodes.

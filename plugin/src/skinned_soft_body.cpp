@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "conform/skin/limb_axes.hpp"
 #include "phase_clock.hpp"
 #include "piece_books.hpp"
 
@@ -134,6 +135,7 @@ SkinnedSoftBody::Impl::Impl(const WorldLink& link, const mesh::SkinnedMesh& mesh
         "SkinnedSoftBody: the world link lacks its world info, add or remove");
   validate(mesh_, skeleton_);
   validate(material_);
+  membrane_.set_bone_axes(skin::bone_axes(skeleton_));
   mesh_.face_tags.resize(mesh_.faces.size());  // a mesh without tags: all skin, from the model
   if (membrane_model()) material_.density = material_.skin.areal_density;  // the books' masses
   adjacency_.build(mesh_);

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace conform::membrane {
 namespace {
@@ -25,15 +27,21 @@ RestFrame rest_frame(const Eigen::Vector3d& x0, const Eigen::Vector3d& x1,
   return f;
 }
 
-// v1 a a^T + v2 b b^T in the frame, a the face's tangent of the axis (prestress_tangent) and
-// b = n x a: the pre-stress S0 (v = the pre-stress), or the neo-Hookean pre-stretch G (v = its
-// principal stretches).
+// The face's pre-stress direction (face_prestress_tangent) in the frame.
+Eigen::Vector2d axis_in_frame(const SkinMaterial& m, const RestFrame& f,
+                              const Eigen::Vector3d& limb_axis) {
+  const Eigen::Vector3d t = face_prestress_tangent(m, f.normal, limb_axis);
+  return {t.dot(f.e1), t.dot(f.e2)};
+}
+
+// v1 a a^T + v2 b b^T in the frame, a the face's tangent of the axis and b = n x a: the
+// pre-stress S0 (v = the pre-stress), or the neo-Hookean pre-stretch G (v = its principal
+// stretches).
 Eigen::Matrix2d principal_in_frame(const SkinMaterial& m, const std::array<double, 2>& v,
-                                   const RestFrame& f) {
+                                   const RestFrame& f, const Eigen::Vector3d& limb_axis) {
   if (v[0] == v[1])  // isotropic: no direction needed
     return v[0] * Eigen::Matrix2d::Identity();
-  const Eigen::Vector3d t = prestress_tangent(m.prestress_axis, f.normal);
-  const Eigen::Vector2d a(t.dot(f.e1), t.dot(f.e2));
+  const Eigen::Vector2d a = axis_in_frame(m, f, limb_axis);
   const Eigen::Vector2d b(-a.y(), a.x());
   return v[0] * a * a.transpose() + v[1] * b * b.transpose();
 }
@@ -53,11 +61,43 @@ Eigen::Vector3d prestress_tangent(const Eigen::Vector3d& axis, const Eigen::Vect
   return t.normalized();
 }
 
+Eigen::Vector3d face_prestress_tangent(const SkinMaterial& material, const Eigen::Vector3d& normal,
+                                       const Eigen::Vector3d& limb_axis) {
+  using Field = SkinMaterial::DirectionField;
+  if (material.prestress_field != Field::axis) {
+    const Eigen::Vector3d n = normal.normalized();
+    const Eigen::Vector3d t = limb_axis - limb_axis.dot(n) * n;
+    if (t.norm() > kNormalAxis * limb_axis.norm() && t.norm() > 0)
+      return material.prestress_field == Field::along_bones
+                 ? Eigen::Vector3d(t.normalized())
+                 : Eigen::Vector3d(n.cross(t).normalized());
+  }
+  return prestress_tangent(material.prestress_axis, normal);
+}
+
+Eigen::Vector3d face_limb_axis(const Eigen::Ref<const Eigen::Matrix3Xd>& vertex_axes,
+                               const mesh::Face& face) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (const std::int32_t v : face) {
+    const Eigen::Vector3d a = vertex_axes.col(v);
+    sum += sum.dot(a) < 0 ? Eigen::Vector3d(-a) : a;
+  }
+  return sum;
+}
+
 void Model::build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<const mesh::Face> faces,
-                  const SkinMaterial& material) {
+                  const SkinMaterial& material, const Eigen::Matrix3Xd* limb_axes) {
   material.validate();
+  if (material.prestress_field != SkinMaterial::DirectionField::axis &&
+      (!limb_axes || limb_axes->cols() != rest.cols()))
+    throw std::invalid_argument(
+        "membrane::Model: prestress_field along_bones or around_bones needs the limb axes of "
+        "every vertex (skin::vertex_limb_axes; given " +
+        std::to_string(limb_axes ? limb_axes->cols() : 0) + " for " + std::to_string(rest.cols()) +
+        " vertices)");
   material_ = material;
-  const bool nh = material.law == SkinMaterial::Law::neo_hookean;
+  const bool nh = material.hyperelastic();
+  const bool fibres = material.law == SkinMaterial::Law::fibre_reinforced;
   lambda_ = nh ? 0.0 : material.lame_lambda();
   mu_ = nh ? material.neo_hookean_mu() : material.lame_mu();
   const std::array<double, 2> stretch =
@@ -78,11 +118,18 @@ void Model::build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<cons
       ++degenerate_;
       continue;
     }
+    const Eigen::Vector3d limb =
+        limb_axes ? face_limb_axis(*limb_axes, face) : Eigen::Vector3d::Zero();
     detail::ElementRest e;
     e.beta = frame.dm.inverse().transpose();  // columns = rows of Dm^-1
-    e.s0 = principal_in_frame(material, material.prestress, frame);
+    e.s0 = principal_in_frame(material, material.prestress, frame, limb);
     e.law = material.law;
-    if (nh) e.g = principal_in_frame(material, stretch, frame);
+    if (nh) e.g = principal_in_frame(material, stretch, frame, limb);
+    if (fibres) {  // q = G a = l1 a
+      e.fibre = stretch[0] * axis_in_frame(material, frame, limb);
+      e.fibre_k1 = material.fibre_stiffness;
+      e.fibre_k2 = material.fibre_nonlinearity;
+    }
     e.area_thickness = frame.area * material.thickness;
     elements_.push_back(e);
     faces_.push_back(face);

@@ -28,8 +28,12 @@ void SkinMaterial::validate() const {
           poisson_ratio, "[0, 0.5)");
   require(finite(thickness) && thickness > 0, "thickness", thickness, "> 0 m");
   require(finite(areal_density) && areal_density > 0, "areal_density", areal_density, "> 0 kg/m^2");
-  require(law == Law::stvk || law == Law::neo_hookean, "law (enumerator)", double(law),
-          "stvk or neo_hookean");
+  require(law == Law::stvk || law == Law::neo_hookean || law == Law::fibre_reinforced,
+          "law (enumerator)", double(law), "stvk, neo_hookean or fibre_reinforced");
+  require(finite(fibre_stiffness) && fibre_stiffness >= 0, "fibre_stiffness", fibre_stiffness,
+          ">= 0 Pa");
+  require(finite(fibre_nonlinearity) && fibre_nonlinearity > 0 && fibre_nonlinearity <= 100,
+          "fibre_nonlinearity", fibre_nonlinearity, "(0, 100]");
   // The StVK law is linear in E: a pre-stress near E would be a pre-strain of order 1, outside
   // its range. The neo-Hookean pre-stretch reaches any finite tension (prestretch.cpp).
   for (int i = 0; i < 2; ++i) {
@@ -40,6 +44,10 @@ void SkinMaterial::validate() const {
     else
       require(finite(prestress[i]) && prestress[i] >= 0, field, prestress[i], "finite and >= 0 Pa");
   }
+  require(
+      prestress_field == DirectionField::axis || prestress_field == DirectionField::along_bones ||
+          prestress_field == DirectionField::around_bones,
+      "prestress_field (enumerator)", double(prestress_field), "axis, along_bones or around_bones");
   require(prestress_axis.allFinite() && prestress_axis.norm() > 0, "prestress_axis (norm)",
           prestress_axis.norm(), "a finite, non-zero direction");
   require(finite(attachment_stiffness) && attachment_stiffness >= 0, "attachment_stiffness",

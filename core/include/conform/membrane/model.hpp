@@ -31,13 +31,26 @@ inline constexpr double kNormalAxis = 1e-3;
 /// the normal only, never on how the face is triangulated. Unit, and normal to n.
 Eigen::Vector3d prestress_tangent(const Eigen::Vector3d& axis, const Eigen::Vector3d& normal);
 
+/// The first principal pre-stress direction of a face of unit normal n under the material's
+/// prestress_field, given the face's limb axis (face_limb_axis; zero without one): unit,
+/// normal to n, and independent of how the face is triangulated.
+Eigen::Vector3d face_prestress_tangent(const SkinMaterial& material, const Eigen::Vector3d& normal,
+                                       const Eigen::Vector3d& limb_axis);
+
+/// The face's limb axis: the sum of its vertices' axes (3 x #V, skin::vertex_limb_axes), each
+/// turned to agree in sign with the first non-zero one (an axis is a line, not an arrow).
+Eigen::Vector3d face_limb_axis(const Eigen::Ref<const Eigen::Matrix3Xd>& vertex_axes,
+                               const mesh::Face& face);
+
 class Model {
  public:
   /// Builds the elements and the nodal areas. Faces whose rest area is below 1e-12 of the
   /// squared longest edge carry no material (counted in degenerate_faces()); the material is
-  /// validated (SkinMaterial::validate throws on a bad field).
+  /// validated (SkinMaterial::validate throws on a bad field). `limb_axes` (3 x #V, per
+  /// vertex; skin::vertex_limb_axes) is what the along_bones and around_bones fields follow;
+  /// those fields without it throw std::invalid_argument.
   void build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<const mesh::Face> faces,
-             const SkinMaterial& material);
+             const SkinMaterial& material, const Eigen::Matrix3Xd* limb_axes = nullptr);
 
   std::int32_t vertex_count() const { return static_cast<std::int32_t>(node_area_.size()); }
   std::int32_t element_count() const { return static_cast<std::int32_t>(elements_.size()); }

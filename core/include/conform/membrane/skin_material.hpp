@@ -25,6 +25,16 @@
 //     Skin's stress-strain curve is J-shaped (stiffens with stretch; Joodaki & Panzer 2018);
 //     neo-Hookean is the simplest hyperelastic law that stays valid at 10-20 % pre-strain
 //     (it stiffens mildly, far less than skin past the toe region).
+//   - Fibre-reinforced law (collagen along the skin-tension lines): a Holzapfel-Gasser-Ogden fibre
+//     term, one family without dispersion. Its two parameters are set from two figures of
+//     Ni Annaidh, Bruyere, Destrade, Gilchrist & Ottenio, "Characterising the anisotropic
+//     mechanical properties of excised human skin", J Mech Behav Biomed Mater 5:139-148 (2012),
+//     scaled to the in-vivo modulus above: k1 = 0.19 E makes the small-strain modulus along the
+//     fibres 1.76 x the modulus across them (E + 4 k1 against E), their ratio of the mean moduli
+//     parallel and perpendicular to Langer's lines (112.5 and 63.8 MPa); k2 = 1.285 makes the
+//     tangent of the uniaxial nominal stress along the fibres at their mean failure strain, 54 %,
+//     70.6 x its value at zero strain, their ratio of the mean linear-region modulus to the mean
+//     initial slope (83.3 and 1.18 MPa): skin's J-shaped curve (membrane_fibre_test checks both).
 //   - Damping: not measured in these units; the default is about critical for the attachment,
 //     2 sqrt(k rho_A) = 1.6e3 Pa s/m, so that secondary motion settles in tens of milliseconds.
 #pragma once
@@ -41,11 +51,22 @@ struct SkinMaterial {
   ///   neo_hookean: incompressible neo-Hookean membrane, mu = E / 3 (nu is unused: the
   ///         thickness follows the area change), pre-stressed by a finite pre-stretch G solved
   ///         from `prestress` (neo_hookean_prestretch); stiffens with stretch.
-  enum class Law { stvk, neo_hookean };
+  ///   fibre_reinforced: the neo-Hookean matrix plus one family of collagen fibres along the
+  ///         first principal pre-stress direction (prestress_axis; detail/fibre.hpp):
+  ///         psi_f = k1 / (2 k2) (exp(k2 (I4 - 1)^2) - 1) where the fibres are stretched
+  ///         (I4 > 1), none where they are not; pre-stretched so that the bind state's stress is
+  ///         still `prestress` (an isotropic pre-stress then needs less stretch along the fibres).
+  enum class Law { stvk, neo_hookean, fibre_reinforced };
   /// Default stvk.
   Law law = Law::stvk;
   /// Young's modulus E, Pa, > 0 (skin in vivo: 0.1-1 MPa; default 0.42 MPa).
   double youngs_modulus = 0.42e6;
+  /// The fibres' stiffness k1 of Law::fibre_reinforced, Pa, finite and >= 0 (default 79.8 kPa,
+  /// 0.19 x the default E; see the sources above). Unused by the other laws.
+  double fibre_stiffness = 79.8e3;
+  /// The fibres' stiffening exponent k2 of Law::fibre_reinforced, dimensionless, in (0, 100]
+  /// (default 1.285; see the sources above). Unused by the other laws.
+  double fibre_nonlinearity = 1.285;
   /// Poisson's ratio nu of the membrane (plane stress), in [0, 0.5) (default 0.48).
   double poisson_ratio = 0.48;
   /// Thickness t, m, > 0 (default 1.5 mm).
@@ -64,6 +85,18 @@ struct SkinMaterial {
   /// it is normal to a face, the face takes a documented fallback tangent that does not depend
   /// on the triangulation (membrane::prestress_tangent in model.hpp).
   Eigen::Vector3d prestress_axis = Eigen::Vector3d::UnitZ();
+  /// Where the first principal pre-stress (and the fibre-reinforced law's fibres) points:
+  ///   axis:         prestress_axis, constant, projected onto each face (the flat sheets);
+  ///   along_bones:  along each limb, the face's tangent of its vertices' weight-blended bone
+  ///                 axes (skin/limb_axes.hpp);
+  ///   around_bones: around each limb, n x that tangent: on the limbs Langer's lines, and skin's
+  ///                 larger tension, run mostly around the limb (Langer 1861; Ridge & Wright,
+  ///                 J Anat 100:297-306, 1966), so this is the field for a character's skin.
+  /// The bone fields need the skeleton's axes (Model::build's limb_axes); where a face has
+  /// none, or its limb axis is normal to it (a limb's end), it takes prestress_axis's tangent.
+  enum class DirectionField { axis, along_bones, around_bones };
+  /// Default axis.
+  DirectionField prestress_field = DirectionField::axis;
   /// Tangential stiffness of the attachment to the skinned target (the subcutaneous layer in
   /// shear), Pa/m = N/m^3: force per unit area per metre of offset along the surface, >= 0
   /// (default 4e5 Pa/m).
@@ -84,6 +117,8 @@ struct SkinMaterial {
   /// Plane-stress Lame constants: lambda = E nu / (1 - nu^2), mu = E / (2 (1 + nu)), Pa.
   double lame_lambda() const;
   double lame_mu() const;
+  /// Whether the law is neo-Hookean or fibre-reinforced (a neo-Hookean matrix).
+  bool hyperelastic() const { return law != Law::stvk; }
   /// The neo-Hookean law's shear modulus E / 3, Pa.
   double neo_hookean_mu() const { return youngs_modulus / 3; }
   /// The stress scale S of the solver's relative tolerance, Pa: the larger principal
@@ -98,7 +133,8 @@ struct SkinMaterial {
 double equibiaxial_prestress(const SkinMaterial& material, double prestrain);
 
 /// The neo-Hookean law's principal pre-stretches [l1, l2] (along the pre-stress axis and across
-/// it) whose plane-stress Cauchy stress mu (l_i^2 - 1 / (l1 l2)^2) is the material's
+/// it) whose plane-stress Cauchy stress mu (l_i^2 - 1 / (l1 l2)^2) (plus, for the
+/// fibre-reinforced law, the fibres' 2 psi_f'(l1^2 - 1) l1^2 along the axis) is the material's
 /// `prestress` (to 1e-13 relative); [1, 1] without pre-stress. Depends on the material only.
 std::array<double, 2> neo_hookean_prestretch(const SkinMaterial& material);
 

@@ -32,11 +32,17 @@
 //                + k/2 (beta_a^T Ci beta_b) F Ci F^T ];
 // where wrinkled, the StVK blocks' v, u with p, m -> q, r (not unit) and the coefficients c1,
 // 2 c2 in place of (k - lambda^2 / k), 4 mu r. The StVK code paths are unchanged.
+//
+// The fibre-reinforced law adds its fibre term (detail/fibre.hpp) to the neo-Hookean element in
+// every regime: S_f to S (so to P and S+), psi_f to psi, and to the material blocks, from
+// q^T dE q = sum_b w_b . dx_b with w_b = (q . beta_b) F q,
+//   K_ab += A t 4 psi_f'' w_a w_b^T.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Eigenvalues>
 
+#include "conform/membrane/detail/fibre.hpp"
 #include "conform/membrane/detail/neo_hookean.hpp"
 #include "conform/membrane/detail/tension_field.hpp"
 #include "conform/membrane/skin_material.hpp"
@@ -54,7 +60,16 @@ struct ElementRest {
   // along the pre-stress axes); the identity, and unused, for stvk.
   Eigen::Matrix2d g = Eigen::Matrix2d::Identity();
   SkinMaterial::Law law = SkinMaterial::Law::stvk;
+  // The fibre-reinforced law's fibres q = G a in the element's frame (a the unit pre-stress
+  // axis), and its k1 (Pa) and k2; q = 0 (no fibres) for the other laws.
+  Eigen::Vector2d fibre = Eigen::Vector2d::Zero();
+  double fibre_k1 = 0, fibre_k2 = 1;
 };
+
+/// Whether the element's law is neo-Hookean or built on it (the fibre-reinforced law).
+inline bool hyperelastic(SkinMaterial::Law law) {
+  return law != SkinMaterial::Law::stvk;
+}
 
 inline Eigen::Vector2d beta_of(const ElementRest& e, int corner) {
   if (corner == 0) return -e.beta.col(0) - e.beta.col(1);
@@ -113,13 +128,24 @@ struct ElementState {
   SkinMaterial::Law law = SkinMaterial::Law::stvk;
   NeoHookeanTerms nh;                     // neo-Hookean: Ci, det Ch (taut)
   double wrinkle_c1 = 0, wrinkle_c2 = 0;  // neo-Hookean, wrinkled: c1, c2
+  double fibre_stiffness = 0;             // fibre-reinforced: 4 psi_f'' (0: no fibre term)
 };
+
+/// Adds the fibre term (fibre.hpp) to S and psi of an element of the fibre-reinforced law.
+inline void add_fibre(const ElementRest& e, const Eigen::Matrix2d& c, ElementState& s) {
+  if (e.fibre_k1 <= 0) return;
+  const FibreTerms t =
+      fibre_terms(e.fibre, 0.5 * (c - Eigen::Matrix2d::Identity()), e.fibre_k1, e.fibre_k2);
+  s.stress += t.stress * e.fibre * e.fibre.transpose();
+  s.psi += t.energy;
+  s.fibre_stiffness = t.stiffness;
+}
 
 /// The neo-Hookean element_forces (see neo_hookean.hpp): the relaxed state first, so that a
 /// collapsed element (det C = 0, infinite taut energy) that is wrinkled or slack stays finite.
 inline void neo_hookean_forces(const ElementRest& e, const Mat32& f, double mu, bool wrinkling,
                                ElementState& s) {
-  s.law = SkinMaterial::Law::neo_hookean;
+  s.law = e.law;
   s.f = f;
   const Eigen::Matrix2d c = f.transpose() * f;
   if (wrinkling) {
@@ -132,6 +158,7 @@ inline void neo_hookean_forces(const ElementRest& e, const Mat32& f, double mu, 
       s.dir_m = r.r;
       s.wrinkle_c1 = r.c1;
       s.wrinkle_c2 = r.c2;
+      add_fibre(e, c, s);
       s.p = s.f * s.stress;
       return;
     }
@@ -139,6 +166,7 @@ inline void neo_hookean_forces(const ElementRest& e, const Mat32& f, double mu, 
   s.nh = neo_hookean_terms(e.g, c);
   s.stress = neo_hookean_stress(e.g, s.nh, mu);
   s.psi = neo_hookean_energy(e.g, 0.5 * (c - Eigen::Matrix2d::Identity()), s.nh, mu);
+  add_fibre(e, c, s);
   s.p = s.f * s.stress;
 }
 
@@ -147,7 +175,7 @@ inline ElementState element_forces(const ElementRest& e, const Eigen::Vector3d& 
                                    const Eigen::Vector3d& x1, const Eigen::Vector3d& x2,
                                    double lambda, double mu, bool wrinkling) {
   ElementState s;  // one object on every path (returned in place)
-  if (e.law == SkinMaterial::Law::neo_hookean) {
+  if (hyperelastic(e.law)) {
     neo_hookean_forces(e, deformation_gradient(e, x0, x1, x2), mu, wrinkling, s);
     return s;
   }
@@ -171,7 +199,7 @@ inline ElementState element_forces(const ElementRest& e, const Eigen::Vector3d& 
 /// S+, F F^T (and F p, F m where wrinkled) from F and S: what the Hessian blocks need.
 inline void add_hessian_terms(ElementState& s) {
   s.s_pos = positive_part(s.stress);
-  if (s.law == SkinMaterial::Law::neo_hookean && s.regime == Regime::taut)
+  if (hyperelastic(s.law) && s.regime == Regime::taut)
     s.ff = s.f * s.nh.c_inv * s.f.transpose();
   else
     s.ff = s.f * s.f.transpose();
@@ -203,6 +231,30 @@ inline double uniaxial_modulus(double lambda, double mu) {
   return k - lambda * lambda / k;
 }
 
+/// Adds dP beta_a to corner a's out (beta_0 = -beta_1 - beta_2).
+inline void add_corner_forces(const ElementRest& e, const Mat32& dp, Eigen::Vector3d& out0,
+                              Eigen::Vector3d& out1, Eigen::Vector3d& out2) {
+  const Eigen::Vector3d g1 = dp * e.beta.col(0), g2 = dp * e.beta.col(1);
+  out1 += g1;
+  out2 += g2;
+  out0 += -g1 - g2;
+}
+
+/// The fibre term's share of the Hessian action, written to out0..out2 (zero without fibres):
+/// A t 4 psi_f'' (q^T dE q) w_a, q^T dE q = (F q) . (dF q), w_a = (q . beta_a) F q.
+inline void fibre_action(const ElementRest& e, const ElementState& s, const Mat32& df,
+                         Eigen::Vector3d& out0, Eigen::Vector3d& out1, Eigen::Vector3d& out2) {
+  out0.setZero();
+  out1.setZero();
+  out2.setZero();
+  if (s.fibre_stiffness <= 0) return;
+  const Eigen::Vector3d fq = s.f * e.fibre;
+  const double c = e.area_thickness * s.fibre_stiffness * fq.dot(df * e.fibre);
+  out0 = c * e.fibre.dot(beta_of(e, 0)) * fq;
+  out1 = c * e.fibre.dot(beta_of(e, 1)) * fq;
+  out2 = c * e.fibre.dot(beta_of(e, 2)) * fq;
+}
+
 /// Hessian approximation times (dx0, dx1, dx2): the three 3-vectors written to out0..out2.
 inline void hessian_apply(const ElementRest& e, const ElementState& s, double lambda, double mu,
                           const Eigen::Vector3d& d0, const Eigen::Vector3d& d1,
@@ -212,15 +264,14 @@ inline void hessian_apply(const ElementRest& e, const ElementState& s, double la
   ds.col(0) = d1 - d0;
   ds.col(1) = d2 - d0;
   const Mat32 df = ds * e.beta.transpose();
-  const bool nh = s.law == SkinMaterial::Law::neo_hookean;
+  const bool nh = hyperelastic(s.law);
+  fibre_action(e, s, df, out0, out1, out2);  // zero without fibres
   if (nh && s.regime == Regime::taut) {
     const Eigen::Matrix2d m = s.f.transpose() * df;
     const Mat32 dp =
         e.area_thickness *
         (df * s.s_pos + s.f * neo_hookean_tangent(s.nh, mu, 0.5 * (m + m.transpose())));
-    out1 = dp * e.beta.col(0);
-    out2 = dp * e.beta.col(1);
-    out0 = -out1 - out2;
+    add_corner_forces(e, dp, out0, out1, out2);
     return;
   }
   if (s.regime == Regime::taut) {
@@ -234,9 +285,7 @@ inline void hessian_apply(const ElementRest& e, const ElementState& s, double la
     return;
   }
   const Mat32 dp = e.area_thickness * df * s.s_pos;  // geometric part (S+ = S*)
-  out1 = dp * e.beta.col(0);
-  out2 = dp * e.beta.col(1);
-  out0 = -out1 - out2;
+  add_corner_forces(e, dp, out0, out1, out2);
   if (s.regime == Regime::slack) return;
   const WrinkledCorner w[3] = {wrinkled_corner(s, beta_of(e, 0)), wrinkled_corner(s, beta_of(e, 1)),
                                wrinkled_corner(s, beta_of(e, 2))};
@@ -261,13 +310,13 @@ inline Eigen::Matrix3d neo_hookean_block(const ElementState& s, double mu,
   return k * (ha * hb.transpose() + 0.5 * hb * ha.transpose() + 0.5 * ca.dot(bb) * s.ff);
 }
 
-/// Block (a, b) of the Hessian approximation (corners a, b in 0..2).
-inline Eigen::Matrix3d hessian_block(const ElementRest& e, const ElementState& s, double lambda,
-                                     double mu, int a, int b) {
-  const Eigen::Vector2d ba = beta_of(e, a), bb = beta_of(e, b);
+/// Block (a, b) of the Hessian approximation without the fibre term.
+inline Eigen::Matrix3d matrix_block(const ElementRest& e, const ElementState& s, double lambda,
+                                    double mu, const Eigen::Vector2d& ba,
+                                    const Eigen::Vector2d& bb) {
   const Eigen::Matrix3d geometric = ba.dot(s.s_pos * bb) * Eigen::Matrix3d::Identity();
   if (s.regime == Regime::slack) return e.area_thickness * geometric;
-  const bool nh = s.law == SkinMaterial::Law::neo_hookean;
+  const bool nh = hyperelastic(s.law);
   if (s.regime == Regime::wrinkled) {
     const WrinkledCorner wa = wrinkled_corner(s, ba), wb = wrinkled_corner(s, bb);
     if (nh)
@@ -282,6 +331,18 @@ inline Eigen::Matrix3d hessian_block(const ElementRest& e, const ElementState& s
                              lambda * fa * fb.transpose());
 }
 
+/// Block (a, b) of the Hessian approximation (corners a, b in 0..2).
+inline Eigen::Matrix3d hessian_block(const ElementRest& e, const ElementState& s, double lambda,
+                                     double mu, int a, int b) {
+  const Eigen::Vector2d ba = beta_of(e, a), bb = beta_of(e, b);
+  const Eigen::Matrix3d block = matrix_block(e, s, lambda, mu, ba, bb);
+  if (s.fibre_stiffness <= 0) return block;
+  // The fibres' rank-one block, in every regime: A t 4 psi_f'' w_a w_b^T.
+  const Eigen::Vector3d fq = s.f * e.fibre;
+  return block + e.area_thickness * s.fibre_stiffness * e.fibre.dot(ba) * e.fibre.dot(bb) * fq *
+                     fq.transpose();
+}
+
 /// The element's six distinct blocks K_ab, a <= b, in the order (0,0), (0,1), (0,2), (1,1),
 /// (1,2), (2,2) (the formula of hessian_block, with each corner's terms computed once); the
 /// others are K_ba = K_ab^T, since S+ and F F^T are symmetric.
@@ -289,7 +350,7 @@ inline void hessian_upper_blocks(const ElementRest& e, const ElementState& s, do
                                  double mu, Eigen::Matrix3d* out) {
   // The rare relaxed elements, and the neo-Hookean law (whose blocks are not yet shared
   // corner by corner): block by block.
-  if (s.regime != Regime::taut || s.law == SkinMaterial::Law::neo_hookean) {
+  if (s.regime != Regime::taut || hyperelastic(s.law)) {
     int k = 0;
     for (int a = 0; a < 3; ++a)
       for (int b = a; b < 3; ++b, ++k) out[k] = hessian_block(e, s, lambda, mu, a, b);
