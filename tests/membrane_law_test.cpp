@@ -115,24 +115,38 @@ TEST(MembraneLaw, NeoHookeanIsLinearElasticityWithPoissonHalfAtSmallStrain) {
     }
 }
 
+// The pre-stresses the pre-stretch tests try, Pa.
+constexpr std::array<std::array<double, 2>, 4> kPrestresses = {
+    {{80.8e3, 80.8e3}, {60e3, 20e3}, {0, 150e3}, {840e3, 10e3}}};
+
+// The law, unstressed but for `sigma`, with its axis at 45 degrees in the element's frame.
+SkinMaterial prestressed_at_45(Law law, const std::array<double, 2>& sigma) {
+  SkinMaterial m = unstressed(law);
+  m.prestress = sigma;
+  m.prestress_axis = Eigen::Vector3d(1, 1, 0);
+  return m;
+}
+
+// Unloaded (x = rest, F = I) the Cauchy stress should be the pre-stress, s1 a a^T + s2 b b^T:
+// the largest difference, Pa.
+double bind_stress_error(const Triangle& t, const SkinMaterial& m) {
+  Model model;
+  model.build(t.rest, t.faces, m);
+  const Eigen::Vector2d a = Eigen::Vector2d(1, 1).normalized(), b(-a.y(), a.x());
+  const Eigen::Matrix2d expected =
+      m.prestress[0] * a * a.transpose() + m.prestress[1] * b * b.transpose();
+  return (cauchy(model, t.rest) - expected).cwiseAbs().maxCoeff();
+}
+
 TEST(MembraneLaw, PrestretchReproducesThePrestressOfTheBindState) {
   const Triangle t = right_triangle();
-  for (const std::array<double, 2> sigma :
-       {std::array<double, 2>{80.8e3, 80.8e3}, std::array<double, 2>{60e3, 20e3},
-        std::array<double, 2>{0, 150e3}, std::array<double, 2>{840e3, 10e3}}) {
-    SkinMaterial m = unstressed(Law::neo_hookean);
-    m.prestress = sigma;
-    m.prestress_axis = Eigen::Vector3d(1, 1, 0);  // 45 degrees in the element's frame
+  for (const std::array<double, 2>& sigma : kPrestresses) {
+    const SkinMaterial m = prestressed_at_45(Law::neo_hookean, sigma);
     const std::array<double, 2> l = neo_hookean_prestretch(m);
     const double mu = m.neo_hookean_mu(), c = 1 / std::pow(l[0] * l[1], 2);
     EXPECT_NEAR(mu * (l[0] * l[0] - c), sigma[0], 1e-12 * mu);
     EXPECT_NEAR(mu * (l[1] * l[1] - c), sigma[1], 1e-12 * mu);
-    Model model;
-    model.build(t.rest, t.faces, m);
-    // Unloaded (x = rest, F = I): the Cauchy stress is the pre-stress, s1 a a^T + s2 b b^T.
-    const Eigen::Vector2d a = Eigen::Vector2d(1, 1).normalized(), b(-a.y(), a.x());
-    const Eigen::Matrix2d expected = sigma[0] * a * a.transpose() + sigma[1] * b * b.transpose();
-    EXPECT_LT((cauchy(model, t.rest) - expected).cwiseAbs().maxCoeff(), 1e-12 * mu);
+    EXPECT_LT(bind_stress_error(t, m), 1e-12 * mu);
   }
   EXPECT_EQ(neo_hookean_prestretch(unstressed(Law::neo_hookean)), (std::array<double, 2>{1, 1}));
 }
@@ -303,19 +317,11 @@ TEST(MembraneLaw, FibreReinforcedDefaultsReproduceTheirTwoSourceRatios) {
 
 TEST(MembraneLaw, FibreReinforcedPrestretchReproducesThePrestress) {
   const Triangle t = right_triangle();
-  for (const std::array<double, 2> sigma :
-       {std::array<double, 2>{80.8e3, 80.8e3}, std::array<double, 2>{60e3, 20e3},
-        std::array<double, 2>{0, 150e3}, std::array<double, 2>{840e3, 10e3}}) {
-    SkinMaterial m = unstressed(Law::fibre_reinforced);
-    m.prestress = sigma;
-    m.prestress_axis = Eigen::Vector3d(1, 1, 0);  // 45 degrees in the element's frame
+  for (const std::array<double, 2>& sigma : kPrestresses) {
+    const SkinMaterial m = prestressed_at_45(Law::fibre_reinforced, sigma);
     const std::array<double, 2> l = neo_hookean_prestretch(m);
-    Model model;
-    model.build(t.rest, t.faces, m);
-    const Eigen::Vector2d a = Eigen::Vector2d(1, 1).normalized(), b(-a.y(), a.x());
-    const Eigen::Matrix2d expected = sigma[0] * a * a.transpose() + sigma[1] * b * b.transpose();
     const double scale = m.neo_hookean_mu() + sigma[0] + sigma[1];
-    EXPECT_LT((cauchy(model, t.rest) - expected).cwiseAbs().maxCoeff(), 1e-12 * scale);
+    EXPECT_LT(bind_stress_error(t, m), 1e-12 * scale);
     // The fibres take part of the tension along the axis: less stretch there than the
     // neo-Hookean matrix alone needs for the same pre-stress.
     SkinMaterial matrix = m;

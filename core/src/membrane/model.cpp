@@ -96,7 +96,7 @@ void Model::build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<cons
         std::to_string(limb_axes ? limb_axes->cols() : 0) + " for " + std::to_string(rest.cols()) +
         " vertices)");
   material_ = material;
-  const bool nh = material.hyperelastic();
+  const bool nh = hyperelastic(material.law);
   const bool fibres = material.law == SkinMaterial::Law::fibre_reinforced;
   lambda_ = nh ? 0.0 : material.lame_lambda();
   mu_ = nh ? material.neo_hookean_mu() : material.lame_mu();

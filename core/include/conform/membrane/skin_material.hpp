@@ -34,7 +34,7 @@
 //     parallel and perpendicular to Langer's lines (112.5 and 63.8 MPa); k2 = 1.285 makes the
 //     tangent of the uniaxial nominal stress along the fibres at their mean failure strain, 54 %,
 //     70.6 x its value at zero strain, their ratio of the mean linear-region modulus to the mean
-//     initial slope (83.3 and 1.18 MPa): skin's J-shaped curve (membrane_fibre_test checks both).
+//     initial slope (83.3 and 1.18 MPa): skin's J-shaped curve (membrane_law_test checks both).
 //   - Damping: not measured in these units; the default is about critical for the attachment,
 //     2 sqrt(k rho_A) = 1.6e3 Pa s/m, so that secondary motion settles in tens of milliseconds.
 #pragma once
@@ -117,8 +117,6 @@ struct SkinMaterial {
   /// Plane-stress Lame constants: lambda = E nu / (1 - nu^2), mu = E / (2 (1 + nu)), Pa.
   double lame_lambda() const;
   double lame_mu() const;
-  /// Whether the law is neo-Hookean or fibre-reinforced (a neo-Hookean matrix).
-  bool hyperelastic() const { return law != Law::stvk; }
   /// The neo-Hookean law's shear modulus E / 3, Pa.
   double neo_hookean_mu() const { return youngs_modulus / 3; }
   /// The stress scale S of the solver's relative tolerance, Pa: the larger principal
@@ -127,6 +125,11 @@ struct SkinMaterial {
   /// Throws std::invalid_argument naming the first field out of its range, with its value.
   void validate() const;
 };
+
+/// Whether the law is neo-Hookean or built on it (the fibre-reinforced law's matrix).
+inline bool hyperelastic(SkinMaterial::Law law) {
+  return law != SkinMaterial::Law::stvk;
+}
 
 /// The pre-stress of an equibiaxial pre-strain eps: sigma = E eps / (1 - nu), Pa (the StVK
 /// law's small-strain relation).

@@ -66,11 +66,6 @@ struct ElementRest {
   double fibre_k1 = 0, fibre_k2 = 1;
 };
 
-/// Whether the element's law is neo-Hookean or built on it (the fibre-reinforced law).
-inline bool hyperelastic(SkinMaterial::Law law) {
-  return law != SkinMaterial::Law::stvk;
-}
-
 inline Eigen::Vector2d beta_of(const ElementRest& e, int corner) {
   if (corner == 0) return -e.beta.col(0) - e.beta.col(1);
   return e.beta.col(corner - 1);
