@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "fuzz_bytes.hpp"
-#include "scene.hpp"
+#include "kinds/scene.hpp"
 
 using namespace conform;
 
