@@ -10,9 +10,9 @@
 #include <utility>
 #include <vector>
 
+#include "base/finite_json.hpp"
 #include "cli/commands.hpp"
 #include "conform/ik/arm_ik.hpp"
-#include "base/finite_json.hpp"
 
 namespace conform::cli {
 

@@ -17,18 +17,18 @@
 #include <string>
 #include <vector>
 
+#include "base/finite_json.hpp"
+#include "base/interrupt.hpp"
+#include "base/output_folder.hpp"
 #include "cli/commands.hpp"
+#include "cli/model_pose.hpp"
+#include "cli/scalpel_csv.hpp"
 #include "conform/io/import.hpp"
 #include "conform/io/mesh_export.hpp"
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/tear.hpp"
-#include "base/interrupt.hpp"
-#include "base/finite_json.hpp"
-#include "cli/model_pose.hpp"
-#include "base/output_folder.hpp"
-#include "cli/scalpel_csv.hpp"
 
 namespace conform::cli {
 

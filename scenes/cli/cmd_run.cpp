@@ -12,9 +12,9 @@
 #include <iostream>
 #include <memory>
 
-#include "cli/commands.hpp"
 #include "base/interrupt.hpp"
 #include "base/output_folder.hpp"
+#include "cli/commands.hpp"
 #include "kinds/scene.hpp"
 
 namespace conform::cli {

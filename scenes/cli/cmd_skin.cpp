@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "cli/commands.hpp"
+#include "cli/model_pose.hpp"
 #include "conform/io/import.hpp"
 #include "conform/io/mesh_export.hpp"
 #include "conform/skin/skinner.hpp"
-#include "cli/model_pose.hpp"
 #include "kinds/output_caps.hpp"
 
 namespace conform::cli {

@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include "conform/bullet/skinned_soft_body.hpp"
 #include "base/scene_config.hpp"
+#include "conform/bullet/skinned_soft_body.hpp"
 
 namespace conform::scenes {
 

@@ -9,13 +9,13 @@
 #include <iostream>
 
 #include "base/child_process.hpp"
+#include "base/finite_json.hpp"
+#include "base/interrupt.hpp"
 #include "conform/bullet/convert.hpp"
 #include "conform/io/mesh_export.hpp"
 #include "conform/version.hpp"
-#include "base/finite_json.hpp"
-#include "render/gltf_sequence.hpp"
-#include "base/interrupt.hpp"
 #include "kinds/output_caps.hpp"
+#include "render/gltf_sequence.hpp"
 #include "render/render_frames.hpp"
 
 namespace conform::scenes {

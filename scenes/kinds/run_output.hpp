@@ -13,11 +13,11 @@
 #include <string>
 #include <vector>
 
+#include "base/progress.hpp"
+#include "base/scene_config.hpp"
 #include "conform/mesh/skinned_mesh.hpp"
 #include "render/frame_snapshot.hpp"
-#include "base/progress.hpp"
 #include "render/render_settings.hpp"
-#include "base/scene_config.hpp"
 
 namespace conform::scenes {
 

@@ -10,8 +10,8 @@
 #include <string_view>
 #include <vector>
 
-#include "kinds/run_output.hpp"
 #include "base/scene_config.hpp"
+#include "kinds/run_output.hpp"
 
 namespace conform::scenes {
 

@@ -8,9 +8,9 @@
 #include <filesystem>
 #include <iostream>
 
-#include "kinds/character_edits.hpp"
 #include "conform/io/import.hpp"
 #include "conform/io/weld_model.hpp"
+#include "kinds/character_edits.hpp"
 #include "kinds/event_time.hpp"
 #include "kinds/model_frame.hpp"
 #include "kinds/scene.hpp"

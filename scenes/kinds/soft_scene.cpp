@@ -63,8 +63,8 @@ void read_skin(Reader& r, const bullet::Material& d, bullet::Material& m) {
   k.attachment_damping = r.number("attachment_damping", e.attachment_damping, 0, 1e9);
   k.wrinkling = r.boolean("wrinkling", e.wrinkling);
   using Law = membrane::SkinMaterial::Law;
-  const std::string law = r.text("law", e.law == Law::neo_hookean ? "neo-hookean" : "stvk",
-                                 {"stvk", "neo-hookean"});
+  const std::string law =
+      r.text("law", e.law == Law::neo_hookean ? "neo-hookean" : "stvk", {"stvk", "neo-hookean"});
   k.law = law == "neo-hookean" ? Law::neo_hookean : Law::stvk;
   if (r.has("tolerance"))
     r.fail("tolerance", r.number("tolerance", 0),

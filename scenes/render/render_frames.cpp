@@ -13,12 +13,12 @@
 #include <thread>
 
 #include "base/child_process.hpp"
+#include "base/interrupt.hpp"
+#include "base/progress.hpp"
 #include "render/colour_scale.hpp"
 #include "render/event_camera.hpp"
 #include "render/f3d_render.hpp"
-#include "base/interrupt.hpp"
 #include "render/picture_compose.hpp"
-#include "base/progress.hpp"
 #include "render/strip_mesh.hpp"
 #include "render/virtual_display.hpp"
 

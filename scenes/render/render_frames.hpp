@@ -25,10 +25,10 @@
 #include <string>
 #include <vector>
 
+#include "base/scene_config.hpp"
 #include "render/f3d_render.hpp"
 #include "render/frame_snapshot.hpp"
 #include "render/render_settings.hpp"
-#include "base/scene_config.hpp"
 #include "render/virtual_display.hpp"
 
 namespace conform::scenes {
