@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# --out is the user's folder (scenes/output_folder.hpp): a run replaces only an earlier Conform
+# --out is the user's folder (scenes/base/output_folder.hpp): a run replaces only an earlier Conform
 # result; it refuses (exit 2, nothing touched) the current folder, its ancestors, the folder of
 # an input and any other folder of files; it removes its lock when it ends and the staging
 # folders of killed runs. And no --out or scene name reaches a shell or gnuplot's command

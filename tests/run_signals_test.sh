@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
-# SIGINT, SIGTERM and SIGHUP stop a run (scenes/interrupt.hpp), whether it is stepping or waiting
-# for a helper (f3d, gnuplot, ffmpeg): it exits 128 + the signal, no process of it is left, its
-# staging folder and lock are gone and the earlier result is untouched. A helper that fails is a
-# failure of the run (exit 1, listed in summary.json), not a warning with exit 0.
+# SIGINT, SIGTERM and SIGHUP stop a run (scenes/base/interrupt.hpp), whether it is stepping or
+# waiting for a helper (f3d, gnuplot, ffmpeg): it exits 128 + the signal, no process of it is
+# left, its staging folder and lock are gone and the earlier result is untouched. A helper that
+# fails is a failure of the run (exit 1, listed in summary.json), not a warning with exit 0.
 set -euo pipefail
 set -m  # each run in a process group of its own (to find its helpers), SIGINT not ignored
 conform="$(realpath "$1")"

@@ -1,4 +1,4 @@
-// A run's output folder is written atomically (scenes/output_folder.hpp): a failed run leaves
+// A run's output folder is written atomically (scenes/base/output_folder.hpp): a failed run leaves
 // the earlier results untouched, a reused folder holds only the new run's files, and a run into
 // a folder that another run is writing is refused. Through the `conform` command.
 #include <fcntl.h>

@@ -1,5 +1,5 @@
 // Fuzz target: the scene parser, from a scene file's text to a prepared scene, as `conform run`
-// reads it (scenes/scene.hpp: load_scene_text; nothing runs and nothing is written). Input:
+// reads it (scenes/kinds/scene.hpp: load_scene_text; nothing runs and nothing is written). Input:
 // optional first lines "set KEY=VALUE" (the command line's --set), then the JSON text.
 // Properties, for any text:
 //   - the parser refuses it with SceneError or std::runtime_error (a message naming the key,
@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "fuzz_bytes.hpp"
-#include "scene.hpp"
+#include "kinds/scene.hpp"
 
 using namespace conform;
 

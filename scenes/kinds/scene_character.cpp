@@ -1,0 +1,343 @@
+// The scene `character`: a user's own rigged model (any file assimp reads) plays its animation
+// through CGA skinning as a Bullet soft body, and is cut, torn and drilled while it plays
+// (character_edits.hpp places the edits on the model). Reported: the soft nodes' distance from
+// their skinned targets, the first step's speed against the animation's, every edit, and the
+// gap across the seams that the import's weld closed (vertices of the file at one rest
+// position), relative to the model's diagonal.
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+
+#include "conform/io/import.hpp"
+#include "conform/io/weld_model.hpp"
+#include "kinds/character_edits.hpp"
+#include "kinds/event_time.hpp"
+#include "kinds/model_frame.hpp"
+#include "kinds/scene.hpp"
+#include "kinds/soft_scene.hpp"
+
+namespace conform::scenes {
+namespace {
+
+// The built-in scene `character`, the defaults of this kind (`conform scenes --show character`).
+constexpr const char* kCharacterJson = R"json({
+  "scene": "character",
+  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body (nodes close to one bone ride it, blended regions follow their skinned targets softly) and, while it plays, its arm is cut off with a capped cut, its flank torn by a scalpel stroke and its base drilled through with a tube; the welded seams are measured for gaps. Units: the model is brought to metres, Y up, at import: model.units_per_metre file units make a metre (\"file\": the unit the file states, FBX's UnitScaleFactor, else 100), model.up (y or z) is the file's up axis (z is turned to y). Edits are placed on the bind pose: cut.point, cut.seed, tear.from, tear.to, drill.tip and drill.base as fractions of its bounding box, tear.blade_a and tear.blade_b as fractions of its size, drill.radius as a fraction of its diagonal, cut.normal in its axes (after model.up); material.margin is in metres, physics.gravity in m/s^2; every length in summary.json is in metres. model.animation = none plays the bind pose (what a model without animation does). cut.region = nearest cuts only the section of the plane nearest cut.seed (by default cut.point), everywhere the unbounded plane.",
+  "seed": 1,
+  "duration": 1.56,
+  "model": { "file": "/usr/share/assimp/models/FBX/huesitos.fbx", "animation": "0",
+             "units_per_metre": "file", "up": "y", "weld": true },
+  "material": { "link_stiffness": 0.02, "target_stiffness": 2000, "target_damping": 20,
+                "kinematic_weight": 0.95, "damping": 0.01 },
+  "cut": { "at": 0.3, "point": [0.68, 0.39, 0.305], "normal": [1, 0, -0.625], "cap": true,
+           "region": "nearest" },
+  "tear": { "at": 0.5, "duration": 0.4, "samples": 12, "from": [0.1, 0.75, 1.0],
+            "to": [0.3, 0.75, 1.0], "blade_a": [0, 0, 0.3], "blade_b": [0, 0, -0.45] },
+  "drill": { "at": 1.1, "tip": [0.6, 0.2, 0.68], "base": [-0.2, 0.2, 0.68], "radius": 0.03,
+             "tube": true },
+  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json";
+
+using Clock = std::chrono::steady_clock;
+
+// The fastest node after the first step and the fastest target motion over it (m/s).
+struct FirstStep {
+  double node_speed = 0, target_speed = 0;
+};
+
+FirstStep first_step(const bullet::SkinnedSoftBody& body,
+                     const std::vector<Eigen::Vector3d>& start_targets, double dt) {
+  FirstStep f;
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v) {
+    if (body.detached(v)) continue;
+    f.node_speed = std::max(f.node_speed, body.velocity(v).norm());
+    f.target_speed = std::max(
+        f.target_speed, (body.target(v) - start_targets[static_cast<std::size_t>(v)]).norm() / dt);
+  }
+  return f;
+}
+
+// What the run carries from step to step.
+struct RunState {
+  double worst_offset = 0, mean_offset_sum = 0, worst_seam_gap = 0;
+  FirstStep first{};
+  Json cut, tear, drill;
+  bool cut_done = false, drill_done = false;
+  double edit_ms = 0, physics_ms = 0;
+};
+
+class Character final : public Scene {
+ public:
+  Character(const Json& scene, const std::string& name, int steps_override) {
+    Reader root(scene, "", resolved_);
+    Reader model = root.object("model");
+    file_ = model.text("file", "/usr/share/assimp/models/FBX/huesitos.fbx");
+    if (file_.rfind("arm", 0) != 0 && !std::filesystem::exists(file_))
+      model.fail("file", Json(file_), "no such file");
+    animation_ = model.text("animation", "0");
+    // A number, or "file" (also when absent): the unit the file states (FBX), else 100.
+    if (model.is_text("units_per_metre") || !model.has("units_per_metre"))
+      model.text("units_per_metre", "file", {"file"});
+    else
+      frame_.units_per_metre = model.number("units_per_metre", 1, 1e-6, 1e6);
+    frame_.up = model.text("up", "y", {"y", "z"});
+    import_.strict_weights = model.boolean("strict_weights", false);
+    weld_ = model.boolean("weld", true);
+    // Seam copies whose bone weights differ: welded with their mean weights (closed seams), or
+    // kept apart as the file has them (mesh/weld.hpp).
+    import_.weld_options.differing_weights =
+        model.text("seam_weights", "mean", {"mean", "keep_apart"}) == "mean"
+            ? mesh::DifferingWeights::mean
+            : mesh::DifferingWeights::keep_apart;
+    import_.isolate = true;  // a corrupt file must not kill or corrupt the run
+    import_.weld = false;    // welded here, to keep the file's seams for the gap measure
+    model.finish();
+    bullet::Material d;
+    // Real characters come at any scale (units_per_metre) and their animations stretch the
+    // skin far from the bind pose; the SI membrane on them is not validated yet, so this scene
+    // keeps Bullet's soft links (material.model = "membrane" to try it).
+    d.model = bullet::MaterialModel::bullet_links;
+    d.kinematic_weight = 0.95;  // nodes near one bone ride it; blended regions jiggle
+    // The animation stretches the skin (edge lengths change), which stiff links at bind-pose
+    // rest lengths would fight: soft links, and a firm pull toward the skinned targets.
+    d.link_stiffness = 0.02;
+    d.target_stiffness = 2000;
+    d.target_damping = 20;
+    d.damping = 0.01;
+    material_ = read_material(root, d);
+    cut_ = read_cut(root);
+    tear_ = read_tear(root);
+    drill_ = read_drill(root);
+    common_ = read_common(root, name, 3.0, steps_override);
+    root.finish();
+  }
+
+  Json run(RunOutput& out) override {
+    CommonSettings c = common_;
+    require_edits_before_end(c);
+    io::SkinnedModel model = io::load_model(file_, import_);
+    // From here on the model is in metres, Y up: Bullet, gravity, the margin and every
+    // length reported are in metres whatever the file's units.
+    to_scene_frame(model, frame_of(model));
+    const Eigen::Matrix3Xd file_rest = model.mesh.rest;
+    const mesh::WeldResult weld =
+        weld_ ? io::weld_model(model, import_.weld_options) : mesh::WeldResult{};
+    for (const auto& w : model.warnings)
+      std::cerr << "warning: " << model.source << ": " << w << "\n";
+    const skin::Animation* animation = chosen_animation(model);
+    SoftWorld w(c);
+    bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(model, material_);
+    // No loop: this animation's last key is not its first, and the wrap would be a jump.
+    if (animation)
+      body.play(*animation, skin::Blend::log, false);
+    else
+      body.set_pose(skin::Pose::rest(model.skeleton));  // the bind pose; physics still acts
+    // The first substep would start the body on the animation's first pose by itself; the
+    // snap does it now, so that frame 0 and the start targets below are of that pose.
+    body.snap_to_pose();
+    const BindPose bind(model.mesh);
+    const SeamGap seams(file_rest, weld.vertex_map);
+    TearRun tear(tear_, bind);
+    std::vector<Eigen::Vector3d> start_targets(static_cast<std::size_t>(body.vertex_count()));
+    for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+      start_targets[static_cast<std::size_t>(v)] = body.target(v);
+    std::int32_t kinematic = 0;
+    for (std::int32_t v = 0; v < body.vertex_count(); ++v) kinematic += body.kinematic(v);
+    out.open_metrics({"t", "offset_mean_m", "offset_max_m", "seam_gap_rel", "pieces", "nodes"});
+    RunState s;
+    out.frame("character", 0, body.mesh());
+    const auto loop_start = Clock::now();
+    for (int step = 1; step <= c.steps; ++step) {
+      const auto tp = Clock::now();
+      w.step();
+      s.physics_ms += std::chrono::duration<double, std::milli>(Clock::now() - tp).count();
+      if (step == 1) s.first = first_step(body, start_targets, c.dt);
+      const auto te = Clock::now();
+      edit(body, bind, tear, step * c.dt, s);
+      s.edit_ms += std::chrono::duration<double, std::milli>(Clock::now() - te).count();
+      measure(body, seams, bind, step, c, s, out);
+      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
+        body.sync_mesh();
+        out.frame("character", step, body.mesh());
+      }
+      out.progress(step, c.steps);
+    }
+    const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
+    if (!finite_nodes(body)) throw std::runtime_error("the soft body blew up (non-finite nodes)");
+    if (tear_.enabled) s.tear = tear.summary(body);
+    Json metrics = summarize(body, model, animation, weld, seams, bind, kinematic, c, s);
+    add_plots(out);
+    out.finish(resolved_, metrics,
+               {{"model_vertices", model.mesh.vertex_count()},
+                {"physics_ms_per_step", s.physics_ms / c.steps},
+                {"edits_ms", s.edit_ms}},
+               c.steps, c.steps * c.dt, loop_s);
+    return metrics;
+  }
+
+ private:
+  // The file's units: model.units_per_metre, or the unit the file states (FBX's
+  // UnitScaleFactor, in centimetres), or, when it states none, 100 (the scene's former default).
+  ModelFrame frame_of(const io::SkinnedModel& model) {
+    ModelFrame frame = frame_;
+    if (frame_.units_per_metre > 0) {
+      units_source_ = "model.units_per_metre";
+    } else if (model.unit_scale_cm > 0) {
+      frame.units_per_metre = 100 / model.unit_scale_cm;
+      units_source_ = "the file's UnitScaleFactor (" + Json(model.unit_scale_cm).dump() + " cm)";
+      if (!(frame.units_per_metre >= 1e-6 && frame.units_per_metre <= 1e6))
+        throw std::runtime_error(file_ + ": its UnitScaleFactor " +
+                                 Json(model.unit_scale_cm).dump() +
+                                 " cm is out of range; set model.units_per_metre");
+    } else {
+      frame.units_per_metre = 100;
+      units_source_ = "assumed: the file states no unit (set model.units_per_metre)";
+    }
+    units_per_metre_ = frame.units_per_metre;
+    return frame;
+  }
+
+  // The animation played, or none (the bind pose): when model.animation is "none", or by
+  // itself, with a note, when the file has no animation at all (a static or posed model).
+  const skin::Animation* chosen_animation(const io::SkinnedModel& model) const {
+    if (animation_ == "none") return nullptr;
+    if (model.animations.empty() && animation_ == "0") {
+      std::cerr << "note: " << file_
+                << " has no animation: it plays its bind pose (model.animation = \"none\")\n";
+      return nullptr;
+    }
+    const int a = model.find_animation(animation_);
+    if (a < 0)
+      throw std::runtime_error(file_ + ": no animation '" + animation_ + "' (" +
+                               std::to_string(model.animations.size()) +
+                               " animations; \"none\" plays the bind pose)");
+    return &model.animations[static_cast<std::size_t>(a)];
+  }
+
+  // Every enabled edit happens before the last step (else it would be skipped unsaid).
+  void require_edits_before_end(const CommonSettings& c) const {
+    if (cut_.enabled) require_before_end(c, "cut.at", cut_.at, "the cut", cut_.at);
+    if (tear_.enabled)
+      require_before_end(c, "tear.at", tear_.at, "the tear's last sample (tear.at + tear.duration)",
+                         tear_.time(tear_.samples - 1));
+    if (drill_.enabled) require_before_end(c, "drill.at", drill_.at, "the drill", drill_.at);
+  }
+
+  // The edits due at time t (between steps, at the body's last pose).
+  void edit(bullet::SkinnedSoftBody& body, const BindPose& bind, TearRun& tear, double t,
+            RunState& s) const {
+    if (cut_.enabled && !s.cut_done && event_due(t, cut_.at)) {
+      s.cut = apply_cut(body, bind, cut_);
+      s.cut_done = true;
+      if (s.cut["status"] != "cut") std::cerr << "warning: the cut missed the model\n";
+    }
+    if (tear_.enabled && !tear.done()) tear.advance(body, t);
+    if (drill_.enabled && !s.drill_done && event_due(t, drill_.at)) {
+      s.drill = apply_drill(body, bind, drill_);
+      s.drill_done = true;
+      if (s.drill["status"] != "drilled") std::cerr << "warning: the drill missed the model\n";
+    }
+  }
+
+  void measure(const bullet::SkinnedSoftBody& body, const SeamGap& seams, const BindPose& bind,
+               int step, const CommonSettings& c, RunState& s, RunOutput& out) const {
+    const OffsetStats o = offsets(body, {});
+    s.worst_offset = std::max(s.worst_offset, o.max), s.mean_offset_sum += o.mean;
+    const double gap = seams.measure(body) / bind.diagonal();
+    s.worst_seam_gap = std::max(s.worst_seam_gap, gap);
+    if (step % c.metrics_every == 0 || step == c.steps) {
+      const double row[] = {
+          step * c.dt, o.mean, o.max, gap, double(body.piece_count()), double(body.vertex_count())};
+      out.metrics().row(row);
+    }
+  }
+
+  Json summarize(const bullet::SkinnedSoftBody& body, const io::SkinnedModel& model,
+                 const skin::Animation* animation, const mesh::WeldResult& weld,
+                 const SeamGap& seams, const BindPose& bind, std::int32_t kinematic,
+                 const CommonSettings& c, const RunState& s) const {
+    Json m = {{"model", file_},
+              {"units_per_metre", units_per_metre_},
+              {"units_per_metre_from", units_source_},
+              {"animation", animation ? animation->name : "none (bind pose)"},
+              // The first step's fastest node against the fastest motion of the skinned targets
+              // over that step (the animation itself), m/s.
+              {"first_step_max_node_speed_m_s", s.first.node_speed},
+              {"first_step_max_target_speed_m_s", s.first.target_speed},
+              {"animation_duration_s", animation ? animation->duration() : 0.0},
+              {"vertices", model.mesh.vertex_count()},
+              {"faces", model.mesh.face_count()},
+              {"bones", model.skeleton.bone_count()},
+              // The bind pose's bounding box in the scene's frame (metres, Y up).
+              {"bind_pose_lo_m", {bind.lo.x(), bind.lo.y(), bind.lo.z()}},
+              {"bind_pose_size_m",
+               {bind.hi.x() - bind.lo.x(), bind.hi.y() - bind.lo.y(), bind.hi.z() - bind.lo.z()}},
+              {"kinematic_nodes", kinematic},
+              {"final_vertices", body.vertex_count()},
+              {"pieces", body.piece_count()},
+              {"secondary_motion_mean_m", s.mean_offset_sum / c.steps},
+              {"secondary_motion_max_m", s.worst_offset},
+              {"seams",
+               {{"welded", weld_},
+                {"file_vertices_at_seams", seams.file_vertices()},
+                {"positions", seams.positions()},
+                {"open_positions", seams.open_positions()},
+                {"merged_vertices", weld.merged},
+                {"mean_weight_positions", std::int64_t(weld.averaged.size())},
+                {"kept_apart_vertices", weld.kept_apart},
+                // The largest distance, over the run, between body vertices standing for file
+                // vertices at one rest position, relative to the bind pose's bounding-box diagonal.
+                {"max_gap_rel", s.worst_seam_gap},
+                {"diagonal_m", bind.diagonal()}}},
+              {"units",
+               "metres, seconds (the file's coordinates / model.units_per_metre, turned Y up "
+               "when model.up is z); secondary motion = distance of a node from its "
+               "CGA-skinned target; edit placements are fractions of the bind pose's box"}};
+    if (cut_.enabled) m["cut"] = s.cut;
+    if (tear_.enabled) m["tear"] = s.tear;
+    if (drill_.enabled) m["drill"] = s.drill;
+    return m;
+  }
+
+  static void add_plots(RunOutput& out) {
+    out.add_plot({"secondary_motion",
+                  "character: soft-body secondary motion",
+                  "time [s]",
+                  "distance from skinned target [m]",
+                  {{"metrics.csv", "t", "offset_mean_m", "mean over nodes", "lines"},
+                   {"metrics.csv", "t", "offset_max_m", "largest", "lines"}},
+                  {}});
+    out.add_plot({"seam_gap",
+                  "character: largest gap across the file's seams",
+                  "time [s]",
+                  "gap / model diagonal",
+                  {{"metrics.csv", "t", "seam_gap_rel", "largest seam gap", "lines"}},
+                  {}});
+  }
+
+  std::string file_, animation_;
+  io::ImportOptions import_;
+  bool weld_ = true;
+  ModelFrame frame_{0, "y"};  // units_per_metre 0: from the file
+  double units_per_metre_ = 0;
+  std::string units_source_;
+  bullet::Material material_;
+  CutEdit cut_;
+  TearEdit tear_;
+  DrillEdit drill_;
+};
+
+std::unique_ptr<Scene> make_character(const Json& scene, const std::string& name, int steps) {
+  return std::make_unique<Character>(scene, name, steps);
+}
+
+const SceneRegistration kCharacterRegistration{
+    {"character",
+     "a real rigged model (assimp) plays its animation through CGA skinning with soft-body "
+     "secondary motion, and is cut, torn and drilled while it plays",
+     kCharacterJson, &make_character, 4, "secondary_motion_max_m"}};
+
+}  // namespace
+}  // namespace conform::scenes

@@ -1,0 +1,338 @@
+// The soft-body scenes of the arm with one topology event, on the Conform plugin (the
+// character scene, a user's model, is scene_character.cpp):
+//   cut        — a planar cut through the forearm of the moving arm; both pieces keep
+//                simulating under gravity, the hand piece stays skinned to its bones;
+//   drill      — a hole drilled through the upper arm, then the arm moves; the hole's rim
+//                stays on the skin (its nodes stay on their skinned targets).
+// Every scene reports how far nodes are from their skinned targets ("offset"), the measure of
+// following the skin.
+#include <chrono>
+#include <cmath>
+#include <numbers>
+
+#include "conform/mesh/analysis.hpp"
+#include "conform/skin/procedural_arm.hpp"
+#include "conform/skin/skinner.hpp"
+#include "kinds/event_time.hpp"
+#include "kinds/scene.hpp"
+#include "kinds/soft_scene.hpp"
+
+namespace conform::scenes {
+namespace {
+
+// The built-in scene `cut`, the defaults of this kind (`conform scenes --show cut`).
+constexpr const char* kCutJson = R"json({
+  "scene": "cut",
+  "description": "The moving procedural arm as a CGA-skinned Bullet soft body (every node pulled toward its skinned target) is cut through the forearm by a plane; both pieces keep simulating under gravity and the hand piece keeps following the wrist and hand bones.",
+  "seed": 1,
+  "duration": 3.0,
+  "model": { "resolution": 1 },
+  "pose": { "shoulder_swing_deg": 20, "elbow_deg": 10, "elbow_swing_deg": 40, "period": 2 },
+  "material": { "target_stiffness": 4000, "target_damping": 40, "kinematic_weight": 2,
+                "damping": 0.02 },
+  "cut": { "at": 0.5, "point": [0, 0, 0.4234], "normal": [0, 0.05, 1], "cap": false },
+  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json";
+// The built-in scene `drill`, the defaults of this kind (`conform scenes --show drill`).
+constexpr const char* kDrillJson = R"json({
+  "scene": "drill",
+  "description": "A cylindrical drill (radius 12 mm) goes through both walls of the upper arm of the CGA-skinned soft arm; the arm then swings and flexes, and the rim nodes are measured against their skinned targets.",
+  "seed": 1,
+  "duration": 3.0,
+  "model": { "resolution": 1 },
+  "pose": { "shoulder_swing_deg": 20, "elbow_deg": 10, "elbow_swing_deg": 40, "period": 2 },
+  "material": { "target_stiffness": 4000, "target_damping": 40, "kinematic_weight": 2,
+                "damping": 0.02 },
+  "drill": { "at": 0.5, "tip": [0.1, 0.0031, 0.1512], "base": [-0.1, 0.0031, 0.1512],
+             "radius": 0.012 },
+  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json";
+using Clock = std::chrono::steady_clock;
+using Vec3 = Eigen::Vector3d;
+constexpr double kPi = std::numbers::pi;
+
+// The arm's motion: the shoulder swings about x, the elbow flexes, with one period.
+struct ArmMotion {
+  double shoulder_deg = 20, elbow_deg = 10, elbow_swing_deg = 40, period = 2, upper = 0.30;
+  void read(Reader& root) {
+    Reader r = root.object("pose");
+    shoulder_deg = r.number("shoulder_swing_deg", shoulder_deg, 0, 90);
+    elbow_deg = r.number("elbow_deg", elbow_deg, 0, 150);
+    elbow_swing_deg = r.number("elbow_swing_deg", elbow_swing_deg, 0, 150);
+    period = r.number("period", period, 0.05, 1000);
+    r.finish();
+  }
+  void pose(const skin::Pose& rest, double t, skin::Pose& p) const {
+    p = rest;
+    const double w = 2 * kPi * t / period, rad = kPi / 180;
+    p.set_local(
+        0, Eigen::Quaterniond(Eigen::AngleAxisd(shoulder_deg * rad * std::sin(w), Vec3::UnitX())),
+        Vec3::Zero());
+    const double elbow = elbow_deg + elbow_swing_deg * 0.5 * (1 - std::cos(w));
+    p.set_local(1, Eigen::Quaterniond(Eigen::AngleAxisd(elbow * rad, Vec3::UnitX())),
+                Vec3(0, 0, upper));
+  }
+};
+
+// A rest-space point carried by `bone` of the arm to time t (its skinning versor M B).
+Vec3 carried(const skin::Skeleton& sk, const ArmMotion& motion, double t, int bone, const Vec3& x) {
+  skin::Pose p;
+  motion.pose(skin::Pose::rest(sk), t, p);
+  std::vector<skin::Versor> global(static_cast<std::size_t>(sk.joint_count()));
+  std::vector<skin::Versor> versors(static_cast<std::size_t>(sk.bone_count()));
+  skin::global_versors(sk, p, global);
+  skin::skinning_versors(sk, global, versors);
+  return versors[static_cast<std::size_t>(bone)].apply(x);
+}
+
+bullet::Material arm_material() {
+  bullet::Material m;
+  m.kinematic_weight = 2;  // every node soft, pulled to its target
+  m.target_stiffness = 4000;
+  m.target_damping = 40;
+  m.damping = 0.02;
+  return m;
+}
+
+mesh::Arm posed_arm(int resolution, const ArmMotion& motion) {
+  mesh::ArmOptions mo;
+  mo.resolution = resolution;
+  mesh::Arm arm = mesh::make_arm(mo);
+  skin::Pose pose;
+  motion.pose(skin::Pose::rest(arm.skeleton), 0, pose);
+  skin::Skinner<double> skinner(arm.skeleton, arm.mesh.rest,
+                                skin::InfluenceLists::from_mesh(arm.mesh));
+  skinner.set_threads(1);
+  skinner.skin(pose, skin::SkinMode::cga);
+  skinner.write(arm.mesh.current);
+  return arm;
+}
+
+// cut and drill share the loop: the arm moves, one event at `at`, offsets measured.
+class ArmEventScene : public Scene {
+ public:
+  enum class Kind { cut, drill };
+  ArmEventScene(Kind kind, const Json& scene, const std::string& name, int steps_override)
+      : kind_(kind) {
+    Reader root(scene, "", resolved_);
+    Reader model = root.object("model");
+    resolution_ = model.integer("resolution", 1, 1, 8);
+    model.finish();
+    motion_.read(root);
+    material_ = read_material(root, arm_material());
+    Reader ev = root.object(kind == Kind::cut ? "cut" : "drill");
+    at_ = ev.number("at", 0.5, 0, 1e5);
+    if (kind == Kind::cut) {
+      point_ = ev.vec3("point", Vec3(0, 0, 0.4234));
+      normal_ = ev.vec3("normal", Vec3(0, 0.05, 1));
+      if (normal_.norm() < 1e-9) ev.fail("normal", Json{0, 0, 0}, "must not be zero");
+      cap_ = ev.boolean("cap", false);
+    } else {
+      tip_ = ev.vec3("tip", Vec3(0.1, 0.0031, 0.1512));
+      base_ = ev.vec3("base", Vec3(-0.1, 0.0031, 0.1512));
+      radius_ = ev.number("radius", 0.012, 1e-4, 0.1);
+      if ((tip_ - base_).norm() < 1e-9)
+        ev.fail("tip", Json{tip_.x(), tip_.y(), tip_.z()}, "must differ from base");
+    }
+    ev.finish();
+    common_ = read_common(root, name, 3.0, steps_override);
+    root.finish();
+  }
+
+  Json run(RunOutput& out) override {
+    const CommonSettings& c = common_;
+    mesh::Arm arm = posed_arm(resolution_, motion_);
+    SoftWorld w(c);
+    bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(arm.mesh, arm.skeleton, material_);
+    const skin::Pose rest = skin::Pose::rest(arm.skeleton);
+    const ArmMotion motion = motion_;
+    body.set_pose_source([motion, rest](double t, skin::Pose& p) { motion.pose(rest, t, p); });
+
+    const bool is_cut = kind_ == Kind::cut;
+    require_before_end(c, is_cut ? "cut.at" : "drill.at", at_, is_cut ? "the cut" : "the drill",
+                       at_);
+    out.open_metrics(is_cut ? std::vector<std::string>{"t", "pieces", "offset_mean", "offset_max",
+                                                       "hand_offset_mean", "hand_offset_max",
+                                                       "rest_offset_mean", "nodes"}
+                            : std::vector<std::string>{"t", "holes", "offset_mean", "offset_max",
+                                                       "rim_offset_mean", "rim_offset_max",
+                                                       "rim_vertices", "nodes"});
+    bool done = false;
+    int holes = 0;
+    double event_ms = 0, physics_ms = 0;
+    Json event;
+    std::vector<std::int32_t> special, others;  // hand (cut) or rim (drill) vertices; the rest
+    OffsetStats worst_special{}, all_special{};
+    long special_samples = 0;
+    out.frame("arm", 0, body.mesh());
+    const auto loop_start = Clock::now();
+    for (int step = 1; step <= c.steps; ++step) {
+      const auto tp = Clock::now();
+      w.step();
+      physics_ms += std::chrono::duration<double, std::milli>(Clock::now() - tp).count();
+      const double t = step * c.dt;
+      if (!done && event_due(t, at_)) {
+        done = true;
+        const auto te = Clock::now();
+        event = is_cut ? cut_at(body, arm, t, special, others)
+                       : drill_at(body, arm, t, holes, special, others);
+        event_ms = std::chrono::duration<double, std::milli>(Clock::now() - te).count();
+        continue;  // offsets are measured once the plugin has skinned the new vertices
+      }
+      const OffsetStats all = offsets(body, {});
+      OffsetStats sp{}, rs{};
+      if (!special.empty()) {
+        sp = offsets(body, special);
+        rs = offsets(body, others);
+        worst_special.max = std::max(worst_special.max, sp.max);
+        all_special.mean += sp.mean, ++special_samples;
+      }
+      if (step % c.metrics_every == 0 || step == c.steps) {
+        const double row[] = {t,
+                              is_cut ? double(body.piece_count()) : double(holes),
+                              all.mean,
+                              all.max,
+                              sp.mean,
+                              sp.max,
+                              is_cut ? rs.mean : double(special.size()),
+                              double(body.vertex_count())};
+        out.metrics().row(row);
+      }
+      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
+        body.sync_mesh();
+        out.frame("arm", step, body.mesh());
+      }
+      out.progress(step, c.steps);
+    }
+    const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
+    if (!finite_nodes(body)) throw std::runtime_error("the soft body blew up (non-finite nodes)");
+    const Json metrics = summary(body, event, all_special, worst_special, special_samples);
+    add_plot(out);
+    Json timings = {{"physics_ms_per_step", physics_ms / c.steps}, {"event_ms", event_ms}};
+    out.finish(resolved_, metrics, timings, c.steps, c.steps * c.dt, loop_s);
+    return metrics;
+  }
+
+  // The cut at time t, its plane given in the rest arm and moved with the forearm (bone 1);
+  // `special` gets the hand piece's vertices (the piece of the finger tips), `others` the rest.
+  Json cut_at(bullet::SkinnedSoftBody& body, const mesh::Arm& arm, double t,
+              std::vector<std::int32_t>& special, std::vector<std::int32_t>& others) const {
+    const std::int32_t fingertip = arm.mesh.vertex_count() - 1;  // the hand's pole
+    const std::int32_t before = body.vertex_count();
+    mesh::CutOptions options;
+    options.cap = cap_;
+    const Vec3 p = carried(arm.skeleton, motion_, t, 1, point_);
+    const Vec3 n = carried(arm.skeleton, motion_, t, 1, point_ + normal_.normalized()) - p;
+    const auto r = body.cut(cga::Plane<double>::from_normal_point(n.normalized(), p), options);
+    Json event = {{"status", r.status == mesh::CutStatus::Cut ? "cut" : "missed"},
+                  {"crossed_edges", r.crossed_edges},
+                  {"new_vertices", body.vertex_count() - before},
+                  {"capped_loops", r.capped_loops}};
+    if (r.status != mesh::CutStatus::Cut) throw std::runtime_error("cut: the plane missed the arm");
+    const mesh::Pieces pieces = mesh::label_pieces(body.mesh());
+    std::vector<std::int32_t> piece_of(static_cast<std::size_t>(body.vertex_count()), -1);
+    for (std::int32_t f = 0; f < body.mesh().face_count(); ++f)
+      for (const std::int32_t v : body.mesh().faces[static_cast<std::size_t>(f)])
+        piece_of[static_cast<std::size_t>(v)] = pieces.face_piece[static_cast<std::size_t>(f)];
+    const std::int32_t hand = piece_of[static_cast<std::size_t>(fingertip)];
+    for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+      (piece_of[static_cast<std::size_t>(v)] == hand ? special : others).push_back(v);
+    event["hand_piece_vertices"] = special.size();
+    return event;
+  }
+
+  // The drill at time t, given in the rest arm and moved with the upper arm (bone 0);
+  // `special` gets the rim (vertices on the cylinder when drilled: new and snapped ones).
+  Json drill_at(bullet::SkinnedSoftBody& body, const mesh::Arm& arm, double t, int& holes,
+                std::vector<std::int32_t>& special, std::vector<std::int32_t>& others) const {
+    const std::int32_t before = body.vertex_count();
+    const mesh::DrillTool tool{carried(arm.skeleton, motion_, t, 0, tip_),
+                               carried(arm.skeleton, motion_, t, 0, base_), radius_};
+    const auto r = body.drill(tool);
+    Json event = {{"holes", r.holes},
+                  {"rim_vertices", r.rim_vertices},
+                  {"removed_area", r.removed_area},
+                  {"refinements", r.refinements},
+                  {"new_vertices", body.vertex_count() - before}};
+    holes = r.holes;
+    if (r.holes == 0) throw std::runtime_error("drill: the drill missed the arm: " + r.message);
+    for (std::int32_t v = 0; v < body.vertex_count(); ++v) {
+      const double d = std::sqrt(mesh::axis_distance_squared(tool, body.position(v)));
+      (std::abs(d - radius_) < 0.02 * radius_ ? special : others).push_back(v);
+    }
+    event["rim_nodes"] = special.size();
+    return event;
+  }
+
+  Json summary(const bullet::SkinnedSoftBody& body, const Json& event,
+               const OffsetStats& all_special, const OffsetStats& worst_special,
+               long special_samples) const {
+    const OffsetStats final_all = offsets(body, {});
+    Json metrics;
+    metrics["event"] = event;
+    metrics["pieces"] = body.piece_count();
+    metrics["nodes"] = body.vertex_count();
+    metrics["offset_mean"] = final_all.mean;
+    metrics["offset_max"] = final_all.max;
+    const std::string what = kind_ == Kind::cut ? "hand" : "rim";
+    metrics[what + "_offset_mean_over_time"] =
+        special_samples ? all_special.mean / special_samples : 0.0;
+    metrics[what + "_offset_max_over_time"] = worst_special.max;
+    metrics["units"] = "metres: offset = distance of a node from its CGA-skinned target";
+    return metrics;
+  }
+
+  void add_plot(RunOutput& out) const {
+    const bool is_cut = kind_ == Kind::cut;
+    out.add_plot({"offsets",
+                  is_cut ? "cut: distance of nodes from their skinned targets"
+                         : "drill: distance of nodes from their skinned targets",
+                  "time [s]",
+                  "distance from skinned target [m]",
+                  is_cut ? std::vector<PlotSeries>{{"metrics.csv", "t", "offset_mean",
+                                                    "all nodes (mean)", "lines"},
+                                                   {"metrics.csv", "t", "hand_offset_mean",
+                                                    "hand piece (mean)", "lines"},
+                                                   {"metrics.csv", "t", "hand_offset_max",
+                                                    "hand piece (max)", "lines"}}
+                         : std::vector<PlotSeries>{{"metrics.csv", "t", "offset_mean",
+                                                    "all nodes (mean)", "lines"},
+                                                   {"metrics.csv", "t", "rim_offset_mean",
+                                                    "hole rim (mean)", "lines"},
+                                                   {"metrics.csv", "t", "rim_offset_max",
+                                                    "hole rim (max)", "lines"}},
+                  {}});
+  }
+
+ private:
+  Kind kind_;
+  int resolution_ = 1;
+  ArmMotion motion_;
+  bullet::Material material_;
+  double at_ = 0.5;
+  Vec3 point_, normal_, tip_, base_;
+  double radius_ = 0.01;
+  bool cap_ = false;
+};
+
+std::unique_ptr<Scene> make_cut(const Json& scene, const std::string& name, int steps) {
+  return std::make_unique<ArmEventScene>(ArmEventScene::Kind::cut, scene, name, steps);
+}
+std::unique_ptr<Scene> make_drill(const Json& scene, const std::string& name, int steps) {
+  return std::make_unique<ArmEventScene>(ArmEventScene::Kind::drill, scene, name, steps);
+}
+const SceneRegistration kCutRegistration{
+    {"cut",
+     "a planar cut through the forearm of the moving soft arm; the pieces keep simulating under "
+     "gravity, the hand piece stays skinned to its bones",
+     kCutJson, &make_cut, 2, "offset_max,offset_mean"}};
+const SceneRegistration kDrillRegistration{
+    {"drill",
+     "a hole drilled through the upper arm, then the arm moves; the hole's rim stays on the skin",
+     kDrillJson, &make_drill, 3, "offset_max,offset_mean"}};
+}  // namespace
+}  // namespace conform::scenes

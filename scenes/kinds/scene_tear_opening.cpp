@@ -1,0 +1,492 @@
+// `tear-opening`: the skinned arm under tension is torn by a scalpel stroke along the forearm;
+// the same stroke is run twice on the same pose:
+//   physics    — a SkinnedSoftBody (Bullet soft body skinned by CGA) whose skin is the
+//                pre-stressed membrane (Material::skin, SI units) attached to the skinned
+//                targets; the wound opens by itself because the skin is under tension
+//                (material.model = "bullet_links" runs Bullet's pre-tensioned links instead);
+//   geometric  — the same tear on the posed mesh alone (Algorithm 2), opened by step 6 (the
+//                borders moved apart by a prescribed sine taper once the stroke ends).
+// Measured over time: the gap-width profile along the tear, the largest opening and the opened
+// area; at the end an elliptical fit of the physical profile (a slit in a stretched membrane
+// opens as an ellipse). pose.flex_deg flexes the elbow after the stroke (the physical wound
+// follows the pose, the geometric one does not); tear.direction = "across" turns the incision
+// around the limb, across skin-tension lines given by material.prestress / prestress_axis.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <sstream>
+
+#include "conform/skin/procedural_arm.hpp"
+#include "conform/skin/skinner.hpp"
+#include "kinds/event_time.hpp"
+#include "kinds/scene.hpp"
+#include "kinds/soft_scene.hpp"
+
+namespace conform::scenes {
+namespace {
+
+// The built-in scene `tear-opening`, the defaults of this kind (`conform scenes --show
+// tear-opening`).
+constexpr const char* kTearOpeningJson = R"json({
+  "scene": "tear-opening",
+  "description": "The procedural arm as a CGA-skinned Bullet soft body whose skin is a pre-stressed membrane in SI units (human skin: E 0.42 MPa, 1.5 mm, 10 % pre-strain) attached to the skinned targets, torn along the forearm by a scalpel stroke; the same stroke on the posed mesh alone is opened by Algorithm 2 step 6. Compares the gap-width profiles over time. material.model = bullet_links runs Bullet's pre-tensioned links instead (the link keys below).",
+  "seed": 1,
+  "duration": 3.0,
+  "model": { "resolution": 1 },
+  "pose": { "elbow_deg": 0, "flex_deg": 0, "flex_at": 1.5, "flex_duration": 0.5 },
+  "material": {
+    "model": "membrane",
+    "youngs_modulus": 420000, "poisson_ratio": 0.48, "thickness": 0.0015, "areal_density": 1.65,
+    "prestress": [80800, 80800], "prestress_axis": [0, 0, 1],
+    "attachment_stiffness": 400000, "attachment_normal_stiffness": 40000000,
+    "attachment_damping": 1600, "wrinkling": true, "relative_tolerance": 0.0012,
+    "pretension": 0.2, "link_stiffness": 0.9, "damping": 0.02, "density": 1.1,
+    "target_stiffness": 4000, "target_damping": 40, "kinematic_weight": 2,
+    "position_iterations": 4, "margin": 0.005
+  },
+  "tear": {
+    "at": 0.5, "duration": 0.5, "samples": 40,
+    "from": [0, 0.0023, 0.3712], "to": [0, 0.0023, 0.4912],
+    "blade_a": [0.09, 0, 0], "blade_b": [0.005, 0, 0], "direction": "along"
+  },
+  "geometric": { "amount": 0.01 },
+  "profiles": { "snapshots": 6, "points": 41 },
+  "physics": { "dt": 0.016666666666666666, "substeps": 1, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json";
+
+using Clock = std::chrono::steady_clock;
+using Vec3 = Eigen::Vector3d;
+
+class TearOpening final : public Scene {
+ public:
+  TearOpening(const Json& scene, const std::string& name, int steps_override) {
+    Reader root(scene, "", resolved_);
+    Reader model = root.object("model");
+    resolution_ = model.integer("resolution", 1, 1, 8);
+    model.finish();
+    Reader pose = root.object("pose");
+    // The stroke is in world space: with a flexed elbow, move it with the forearm.
+    elbow_deg_ = pose.number("elbow_deg", 0, 0, 150);
+    // After the stroke the elbow may flex: the physical wound follows the pose.
+    flex_deg_ = pose.number("flex_deg", 0, -150, 150);
+    flex_at_ = pose.number("flex_at", 1.5, 0, 1e5);
+    flex_duration_ = pose.number("flex_duration", 0.5, 1e-3, 1e5);
+    if (elbow_deg_ + flex_deg_ < 0 || elbow_deg_ + flex_deg_ > 150)
+      pose.fail("flex_deg", flex_deg_, "elbow_deg + flex_deg must stay in [0, 150]");
+    pose.finish();
+    bullet::Material d;
+    d.pretension = 0.2;
+    d.kinematic_weight = 2;     // nothing kinematic: every node follows its target softly
+    d.target_stiffness = 4000;  // sag under gravity g/k = 2.5 mm
+    d.target_damping = 40;
+    d.damping = 0.02;
+    d.position_iterations = 4;
+    material_ = read_material(root, d);
+    Reader tear = root.object("tear");
+    Stroke s;
+    s.at = 0.5, s.duration = 0.5, s.samples = 40;
+    s.from = Vec3(0, 0.0023, 0.3712), s.to = Vec3(0, 0.0023, 0.4912);  // off the vertex columns
+    s.blade_a = Vec3(0.09, 0, 0), s.blade_b = Vec3(0.005, 0, 0);       // crosses the +x wall only
+    stroke_ = read_stroke(tear, s);
+    // "across": the same incision turned a quarter around the limb axis (circumferential),
+    // e.g. across the principal pre-stress of skin-tension lines.
+    across_ = tear.text("direction", "along", {"along", "across"}) == "across";
+    if (across_) {
+      const Vec3 centre = 0.5 * (stroke_.from + stroke_.to);
+      const double half = 0.5 * (stroke_.to - stroke_.from).norm();
+      stroke_.from = centre - half * Vec3::UnitY();
+      stroke_.to = centre + half * Vec3::UnitY();
+    }
+    tear.finish();
+    Reader geo = root.object("geometric");
+    amount_ = geo.number("amount", 0.01, 0, 1);
+    geo.finish();
+    Reader prof = root.object("profiles");
+    snapshots_ = prof.integer("snapshots", 6, 1, 100);
+    bins_ = prof.integer("points", 41, 3, 10000);
+    prof.finish();
+    common_ = read_common(root, name, 3.0, steps_override);
+    root.finish();
+  }
+
+  Json run(RunOutput& out) override {
+    const CommonSettings& c = common_;
+    require_before_end(c, "tear.at", stroke_.at, "the tear's last sample (tear.at + tear.duration)",
+                       stroke_.time(stroke_.samples - 1));
+    if (flex_deg_ != 0) require_before_end(c, "pose.flex_at", flex_at_, "the flex", flex_at_);
+    skin::Pose pose;
+    TearRun r(posed_arm(pose), pose, c, material_);
+    r.body.set_pose_source(flexing_pose(pose));
+    r.bins = profile_positions();
+    r.snapshot_steps = snapshot_steps();
+    out.open_metrics({"t", "physics_tear_points", "geometric_tear_points", "physics_max_opening",
+                      "geometric_max_opening", "physics_area", "geometric_area",
+                      "physics_profile_r2", "geometric_profile_r2", "pieces",
+                      "physics_newton_iterations", "physics_cg_iterations", "physics_residual"});
+    RunOutput::Csv history =
+        out.open_csv("profile_history.csv", {"t", "s", "physics_width", "geometric_width"});
+    out.frame("physics", 0, r.body.mesh());
+    const auto loop_start = Clock::now();
+    for (int step = 1; step <= c.steps; ++step) {
+      r.physics_ms += milliseconds([&] { r.world.step(); });
+      const double t = step * c.dt;
+      note_solve(r, t);
+      r.tear_ms += milliseconds([&] { advance_stroke(r, t); });  // edits only between steps
+      r.measure_ms += milliseconds([&] { measure(r, step, t, out, history); });
+      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
+        r.body.sync_mesh();
+        out.frame("physics", step, r.body.mesh());
+        out.frame("geometric", step, r.geo);
+        out.picture(step, {{"physics", &r.body.mesh(), lips(r.body.tear())},
+                           {"geometric", &r.geo, lips(&r.geo_tear)}});
+      }
+      out.progress(step, c.steps);
+    }
+    const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
+    check_torn(r);
+    write_profiles(r, out);
+    add_plots(r, out);
+    const Json metrics = summary(r);
+    out.finish(resolved_, metrics, timings(r), c.steps, c.steps * c.dt, loop_s);
+    return metrics;
+  }
+
+ private:
+  // Everything one run keeps: the same posed arm torn twice, as a mesh alone (geometric) and
+  // as a soft body (physics), and what is measured along the way.
+  struct TearRun {
+    mesh::Arm arm;
+    mesh::SkinnedMesh geo;  // the geometric run: the mesh alone
+    mesh::Adjacency geo_adjacency;
+    mesh::Tear geo_tear;
+    SoftWorld world;  // the physics run
+    double build_ms = 0;
+    bullet::SkinnedSoftBody& body;
+    std::vector<double> bins;         // normalized positions along the tear where profiles are kept
+    std::vector<int> snapshot_steps;  // steps whose profiles go into profiles.csv
+    std::vector<std::vector<double>> snap_physics, snap_geometric;
+    std::vector<double> snap_times;
+    int next = 0;  // the next stroke sample
+    bool opened = false;
+    Profile phys, geom;
+    double max_phys = 0, max_geom = 0, tear_ms = 0, measure_ms = 0, physics_ms = 0;
+    int tear_steps = 0;
+    double worst_residual = 0, before_flex = -1;  // the membrane's solves; the opening then
+    int unconverged = 0;
+
+    TearRun(mesh::Arm posed, const skin::Pose& pose, const CommonSettings& c,
+            const bullet::Material& material)
+        : arm(std::move(posed)),
+          geo(arm.mesh),
+          geo_adjacency(geo),
+          geo_tear(geo, geo_adjacency, lips()),
+          world(c),
+          body(add_body(world, arm, material, build_ms)) {
+      body.set_pose(pose);
+      body.begin_tear(lips());
+    }
+    // Both runs tear with issue 18's smooth lips (tear.hpp).
+    static mesh::TearOptions lips() {
+      mesh::TearOptions o;
+      o.smooth_lips = true;
+      return o;
+    }
+    static bullet::SkinnedSoftBody& add_body(SoftWorld& w, const mesh::Arm& arm,
+                                             const bullet::Material& material, double& ms) {
+      bullet::SkinnedSoftBody* body = nullptr;
+      ms = milliseconds(
+          [&] { body = &w.plugin->add_skinned_body(arm.mesh, arm.skeleton, material); });
+      return *body;
+    }
+  };
+
+  template <class F>
+  static double milliseconds(F&& f) {
+    const auto t0 = Clock::now();
+    f();
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  }
+
+  // A tear's two borders, the wound the pictures aim at (none before the tear began).
+  static Lips lips(const mesh::Tear* tear) {
+    if (!tear || tear->path_length() < 2) return {};
+    return {tear->left_border(), tear->right_border()};
+  }
+
+  // The arm with its elbow flexed; both runs start from this posed (skinned) arm.
+  mesh::Arm posed_arm(skin::Pose& pose) const {
+    mesh::ArmOptions mo;
+    mo.resolution = resolution_;
+    mesh::Arm arm = mesh::make_arm(mo);
+    pose = skin::Pose::rest(arm.skeleton);
+    pose.set_local(
+        1,
+        Eigen::Quaterniond(Eigen::AngleAxisd(elbow_deg_ * std::numbers::pi / 180, Vec3::UnitX())),
+        Vec3(0, 0, mo.upper_arm));
+    skin::Skinner<double> skinner(arm.skeleton, arm.mesh.rest,
+                                  skin::InfluenceLists::from_mesh(arm.mesh));
+    skinner.set_threads(1);
+    skinner.skin(pose, skin::SkinMode::cga);
+    skinner.write(arm.mesh.current);
+    return arm;
+  }
+
+  // The posed arm, its elbow flexing by flex_deg over flex_duration from flex_at (smoothstep).
+  std::function<void(double, skin::Pose&)> flexing_pose(const skin::Pose& start) const {
+    const double upper_arm = mesh::ArmOptions{}.upper_arm;
+    return [=, this](double time, skin::Pose& out) {
+      out = start;
+      const double u = std::clamp((time - flex_at_) / flex_duration_, 0.0, 1.0);
+      const double deg = elbow_deg_ + flex_deg_ * u * u * (3 - 2 * u);
+      out.set_local(
+          1, Eigen::Quaterniond(Eigen::AngleAxisd(deg * std::numbers::pi / 180, Vec3::UnitX())),
+          Vec3(0, 0, upper_arm));
+    };
+  }
+
+  // The membrane's solve of the step just taken (its worst residual, unconverged substeps) and
+  // the opening as it stood before the elbow flexed.
+  void note_solve(TearRun& r, double t) const {
+    const membrane::SolveReport& solve = r.body.last_solve();
+    r.worst_residual = std::max(r.worst_residual, solve.residual);
+    r.unconverged += material_.model == bullet::MaterialModel::membrane && !solve.converged;
+    if (t <= flex_at_ + 1e-12) r.before_flex = r.phys.max;
+  }
+
+  // The stroke's points along the rest-space tear.
+  std::vector<double> profile_positions() const {
+    std::vector<double> bins(static_cast<std::size_t>(bins_));
+    for (int i = 0; i < bins_; ++i) bins[static_cast<std::size_t>(i)] = double(i) / (bins_ - 1);
+    return bins;
+  }
+
+  // The steps whose profiles are kept: denser early on, where the opening changes fastest.
+  std::vector<int> snapshot_steps() const {
+    const CommonSettings& c = common_;
+    const double end_time = c.steps * c.dt;
+    std::vector<int> steps;
+    for (int k = 0; k < snapshots_; ++k) {
+      const double u = double(k + 1) / snapshots_;
+      const double t = stroke_.at + (end_time - stroke_.at) * u * u;
+      steps.push_back(std::clamp(static_cast<int>(std::lround(t / c.dt)), 1, c.steps));
+    }
+    return steps;
+  }
+
+  // The stroke's samples due by time t cut both runs; Algorithm 2 step 6 opens the geometric
+  // tear once the stroke is done.
+  void advance_stroke(TearRun& r, double t) const {
+    while (r.next < stroke_.samples && event_due(t, stroke_.time(r.next))) {
+      const mesh::ScalpelSample sample = stroke_.sample(r.next);
+      r.body.tear_advance(sample);
+      r.geo_tear.advance(sample);
+      ++r.next, ++r.tear_steps;
+    }
+    if (r.next == stroke_.samples && !r.opened) {
+      r.geo_tear.open(amount_);
+      r.opened = true;
+    }
+  }
+
+  // Both profiles now; a metrics row, the profile history and the snapshots when due.
+  void measure(TearRun& r, int step, double t, RunOutput& out, RunOutput::Csv& history) const {
+    const auto rest_of = [](const mesh::SkinnedMesh& m) {
+      return [&m](std::int32_t v) { return Vec3(m.rest.col(v)); };
+    };
+    const mesh::Tear* pt = r.body.tear();
+    if (pt && pt->path_length() >= 2)
+      r.phys = measure_profile(
+          pt->left_border(), pt->right_border(), [&](std::int32_t v) { return r.body.position(v); },
+          rest_of(r.body.mesh()));
+    if (r.geo_tear.path_length() >= 2)
+      r.geom = measure_profile(
+          r.geo_tear.left_border(), r.geo_tear.right_border(),
+          [&](std::int32_t v) { return Vec3(r.geo.current.col(v)); }, rest_of(r.geo));
+    r.max_phys = std::max(r.max_phys, r.phys.max);
+    r.max_geom = std::max(r.max_geom, r.geom.max);
+    if (step % common_.metrics_every == 0 || step == common_.steps) {
+      const membrane::SolveReport& solve = r.body.last_solve();  // the step's last substep
+      const double row[] = {t,
+                            double(pt ? pt->path_length() : 0),
+                            double(r.geo_tear.path_length()),
+                            r.phys.max,
+                            r.geom.max,
+                            r.phys.area,
+                            r.geom.area,
+                            r.phys.r2,
+                            r.geom.r2,
+                            double(r.body.piece_count()),
+                            double(solve.newton_iterations),
+                            double(solve.cg_iterations),
+                            solve.residual};
+      out.metrics().row(row);
+      if (r.next > 0) {
+        const auto pw = resample(r.phys, r.bins), gw = resample(r.geom, r.bins);
+        for (std::size_t i = 0; i < r.bins.size(); ++i) {
+          const double h[] = {t, r.bins[i], pw[i], gw[i]};
+          history.row(h);
+        }
+      }
+    }
+    for (const int s : r.snapshot_steps)
+      if (s == step) {
+        r.snap_times.push_back(t);
+        r.snap_physics.push_back(resample(r.phys, r.bins));
+        r.snap_geometric.push_back(resample(r.geom, r.bins));
+      }
+  }
+
+  // A run whose scalpel never tore a run measured nothing: an error naming what it missed.
+  static void check_torn(TearRun& r) {
+    const mesh::Tear* pt = r.body.tear();
+    if (!pt || pt->path_length() < 2) {
+      r.body.sync_mesh();
+      const auto& x = r.body.mesh().current;
+      std::ostringstream box;
+      box << "skin bounding box [" << x.rowwise().minCoeff().transpose() << "] – ["
+          << x.rowwise().maxCoeff().transpose() << "] m";
+      throw std::runtime_error("tear-opening: the scalpel never tore the physical skin (" +
+                               (pt ? pt->message() : std::string("no tear")) + "; " + box.str() +
+                               ")");
+    }
+    if (r.geo_tear.path_length() < 2)
+      throw std::runtime_error("tear-opening: the scalpel never tore the mesh (" +
+                               r.geo_tear.message() + ")");
+  }
+
+  // profiles.csv's columns: s, then one per snapshot time for each run.
+  static std::vector<std::string> profile_columns(const TearRun& r) {
+    std::vector<std::string> cols{"s"};
+    char name[48];
+    for (const double t : r.snap_times) {
+      std::snprintf(name, sizeof name, "physics_%.2fs", t);
+      cols.push_back(name);
+    }
+    for (const double t : r.snap_times) {
+      std::snprintf(name, sizeof name, "geometric_%.2fs", t);
+      cols.push_back(name);
+    }
+    return cols;
+  }
+
+  // The snapshots side by side: one row per position along the tear.
+  static void write_profiles(const TearRun& r, RunOutput& out) {
+    RunOutput::Csv profiles = out.open_csv("profiles.csv", profile_columns(r));
+    for (std::size_t i = 0; i < r.bins.size(); ++i) {
+      std::vector<double> row{r.bins[i]};
+      for (const auto& p : r.snap_physics) row.push_back(p[i]);
+      for (const auto& g : r.snap_geometric) row.push_back(g[i]);
+      profiles.row(row);
+    }
+  }
+
+  static void add_plots(const TearRun& r, RunOutput& out) {
+    const std::vector<std::string> cols = profile_columns(r);
+    Plot side{"profiles", "tear-opening: gap-width profile along the tear over time", "", "", {},
+              {}};
+    Plot left{"",
+              "physics (pre-stressed skin membrane in Bullet)",
+              "position along the tear (0 = start, 1 = tip)",
+              "gap width [m]",
+              {},
+              {}};
+    Plot right{"",
+               "geometric (Algorithm 2 step 6)",
+               "position along the tear (0 = start, 1 = tip)",
+               "gap width [m]",
+               {},
+               {}};
+    char name[48];
+    for (std::size_t k = 0; k < r.snap_times.size(); ++k) {
+      std::snprintf(name, sizeof name, "t = %.2f s", r.snap_times[k]);
+      left.series.push_back({"profiles.csv", "s", cols[1 + k], name, "lines"});
+      right.series.push_back(
+          {"profiles.csv", "s", cols[1 + r.snap_times.size() + k], name, "lines"});
+    }
+    side.panels = {left, right};
+    out.add_plot(side);
+    out.add_plot({"opening",
+                  "tear-opening: largest gap width",
+                  "time [s]",
+                  "largest gap width [m]",
+                  {{"metrics.csv", "t", "physics_max_opening", "physics", "lines"},
+                   {"metrics.csv", "t", "geometric_max_opening", "geometric (step 6)", "lines"}},
+                  {}});
+    out.add_plot({"area",
+                  "tear-opening: opened area",
+                  "time [s]",
+                  "opened area [m^2]",
+                  {{"metrics.csv", "t", "physics_area", "physics", "lines"},
+                   {"metrics.csv", "t", "geometric_area", "geometric (step 6)", "lines"}},
+                  {}});
+  }
+
+  Json summary(const TearRun& r) const {
+    const auto part = [](const Profile& p, double largest, const mesh::Tear& tear) {
+      return Json{{"max_opening", p.max},
+                  {"max_opening_over_time", largest},
+                  {"opened_area", p.area},
+                  {"profile_r2", p.r2},
+                  {"profile_fit_max", p.fit_max},
+                  {"tear_length_rest", p.length},
+                  {"tear_points", tear.path_length()}};
+    };
+    Json metrics;
+    metrics["physics"] = part(r.phys, r.max_phys, *r.body.tear());
+    metrics["geometric"] = part(r.geom, r.max_geom, r.geo_tear);
+    metrics["geometric"]["amount"] = amount_;
+    const membrane::SolveReport& solve = r.body.last_solve();
+    metrics["physics"]["residual"] = solve.residual;                    // Pa, the last substep's
+    metrics["physics"]["relative_residual"] = solve.relative_residual;  // over the pre-stress
+    metrics["physics"]["residual_max"] = r.worst_residual;
+    metrics["physics"]["unconverged_substeps"] = r.unconverged;
+    metrics["physics"]["newton_iterations"] = solve.newton_iterations;
+    metrics["physics"]["cg_iterations"] = solve.cg_iterations;
+    metrics["physics"]["max_opening_before_flex"] = r.before_flex;
+    metrics["physics"]["material"] =
+        material_.model == bullet::MaterialModel::membrane ? "membrane" : "bullet_links";
+    metrics["tear_direction"] = across_ ? "across" : "along";
+    metrics["pieces"] = r.body.piece_count();
+    metrics["nodes"] = r.body.vertex_count();
+    metrics["units"] = "metres, square metres; profile_r2 of w_max*sqrt(1-(2s-1)^2)";
+    return metrics;
+  }
+
+  Json timings(const TearRun& r) const {
+    const CommonSettings& c = common_;
+    return {{"physics_ms_per_step", r.physics_ms / c.steps},
+            {"tear_ms_total", r.tear_ms},
+            {"tear_ms_per_sample", r.tear_steps ? r.tear_ms / r.tear_steps : 0.0},
+            {"measure_ms_per_step", r.measure_ms / c.steps},
+            {"build_ms", r.build_ms},
+            {"vertices", r.arm.mesh.vertex_count()},
+            {"faces", r.arm.mesh.face_count()}};
+  }
+
+  int resolution_ = 1;
+  double elbow_deg_ = 0, flex_deg_ = 0, flex_at_ = 1.5, flex_duration_ = 0.5;
+  bool across_ = false;
+  bullet::Material material_;
+  Stroke stroke_;
+  double amount_ = 0.01;
+  int snapshots_ = 6, bins_ = 41;
+};
+
+std::unique_ptr<Scene> make_tear_opening(const Json& scene, const std::string& name,
+                                         int steps_override) {
+  return std::make_unique<TearOpening>(scene, name, steps_override);
+}
+
+const SceneRegistration kTearOpeningRegistration{
+    {"tear-opening",
+     "the skinned arm's pre-stressed skin torn by a scalpel: physical opening (membrane in Bullet) "
+     "vs "
+     "the geometric opening of Algorithm 2 step 6, profiles over time (default scene)",
+     kTearOpeningJson, &make_tear_opening, 0, "physics.max_opening,geometric.max_opening"}};
+
+}  // namespace
+}  // namespace conform::scenes
