@@ -1,6 +1,7 @@
 #include "conform/membrane/model.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 namespace conform::membrane {
@@ -56,6 +57,8 @@ Eigen::Vector3d prestress_tangent(const Eigen::Vector3d& axis, const Eigen::Vect
 void Model::build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<const mesh::Face> faces,
                   const SkinMaterial& material) {
   material.validate();
+  static std::atomic<std::uint64_t> builds{0};
+  build_id_ = ++builds;
   material_ = material;
   const bool nh = material.law == SkinMaterial::Law::neo_hookean;
   lambda_ = nh ? 0.0 : material.lame_lambda();

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include <stdexcept>
@@ -54,7 +55,13 @@ struct Solver::Scratch {
   std::vector<ElementForces> forces_;        // every element at x
   std::vector<ElementForces> guess_forces_;  // every element at the alternative guess
   std::vector<ElementForces> trial_forces_;  // of changed_ at trial_ (line search)
-  std::vector<Eigen::Matrix3d> upper_;       // the changed elements' six upper Hessian blocks each
+  // The last solve's result and its elements' forces, of the model built as last_build_: an
+  // element whose corners are where they were then is not evaluated again (a body at rest, whose
+  // carried guess is the last solution, evaluates only its moving part).
+  std::vector<ElementForces> last_forces_;
+  Eigen::Matrix3Xd last_x_;
+  std::uint64_t last_build_ = 0;
+  std::vector<Eigen::Matrix3d> upper_;  // the changed elements' six upper Hessian blocks each
   std::vector<Eigen::Matrix3d> node_stiffness_, block_inverse_, blocks_;
   std::vector<std::uint8_t> free_;    // per vertex: may move in this solve
   std::vector<std::uint8_t> active_;  // per vertex: moves in this Newton step (a subset of free_)
@@ -84,6 +91,7 @@ struct Context {
   bool dynamic = false;
   int threads = 1;
   double tolerance = 0;  // Pa: relative_tolerance x the stress scale
+  bool reuse = false;    // last_forces_ are of this model's elements at last_x_
 
   bool fixed(std::int64_t v) const {
     return in.fixed[static_cast<std::size_t>(v)] != 0 || model.node_area(std::int32_t(v)) <= 0;
@@ -143,13 +151,26 @@ ElementForces forces_at(const Context& c, std::int64_t e,
           rest.area_thickness * state.p * rest.beta.col(1), rest.area_thickness * state.psi};
 }
 
-// Phase 2: every element's corner forces and energy (parallel over elements). After a Newton
-// step only the changed elements are evaluated again (line_search).
+// Element e's corners are bit for bit where the last solve left them: its forces are the ones
+// kept then (an element's forces depend on its corners' positions only).
+bool unmoved(const Context& c, std::int64_t e, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+  for (const std::int32_t v : c.model.element_faces()[static_cast<std::size_t>(e)])
+    if (std::memcmp(x.col(v).data(), c.s.last_x_.col(v).data(), 3 * sizeof(double)) != 0)
+      return false;
+  return true;
+}
+
+// Phase 2: every element's corner forces and energy (parallel over elements), reusing the last
+// solve's of the elements that have not moved since. After a Newton step only the changed
+// elements are evaluated again (line_search).
 void evaluate_elements(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x,
                        std::vector<ElementForces>& forces) {
   forces.resize(static_cast<std::size_t>(c.ne));
 #pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
-  for (std::int64_t e = 0; e < c.ne; ++e) forces[static_cast<std::size_t>(e)] = forces_at(c, e, x);
+  for (std::int64_t e = 0; e < c.ne; ++e)
+    forces[static_cast<std::size_t>(e)] = c.reuse && unmoved(c, e, x)
+                                              ? c.s.last_forces_[static_cast<std::size_t>(e)]
+                                              : forces_at(c, e, x);
 }
 
 // The nodal part of Phi at node v: 1/2 d^T K d + 1/2 w |x - xp|^2 (d = x - T).
@@ -592,6 +613,8 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
     require_cols(input.target_velocities, nv, false, "target_velocities");
   }
   if (!x.allFinite()) throw std::invalid_argument("membrane solve: x holds a non-finite value");
+  c.reuse = model.build_id() != 0 && s.last_build_ == model.build_id() && s.last_x_.cols() == nv &&
+            s.last_forces_.size() == std::size_t(c.ne);
   prepare_nodes(c, x);
   s.free_.resize(std::size_t(nv));
   for (Eigen::Index v = 0; v < nv; ++v) s.free_[std::size_t(v)] = !c.fixed(v);
@@ -615,6 +638,9 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
     report.cg_iterations += conjugate_gradients(c);
     if (!line_search(c, x)) break;
   }
+  s.last_x_ = x;  // forces_ are of x's elements (line_search keeps them so)
+  std::swap(s.last_forces_, s.forces_);
+  s.last_build_ = model.build_id();
   return report;
 }
 
