@@ -1,6 +1,7 @@
 #include "conform/membrane/model.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -95,6 +96,8 @@ void Model::build(const Eigen::Ref<const Eigen::Matrix3Xd>& rest, std::span<cons
         "every vertex (skin::vertex_limb_axes; given " +
         std::to_string(limb_axes ? limb_axes->cols() : 0) + " for " + std::to_string(rest.cols()) +
         " vertices)");
+  static std::atomic<std::uint64_t> builds{0};
+  build_id_ = ++builds;
   material_ = material;
   const bool nh = hyperelastic(material.law);
   const bool fibres = material.law == SkinMaterial::Law::fibre_reinforced;

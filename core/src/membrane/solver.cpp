@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <sstream>
 
 #include <stdexcept>
@@ -37,14 +38,37 @@ void SolverSettings::validate() const {
   check(local_reach > 0 && std::isfinite(local_reach), "local_reach", local_reach, "> 0");
 }
 
+namespace {
+
+// What the gradient and the potential need of an element at given positions: its corner forces
+// (f1 = A t P beta_1 at corner 1, f2 = A t P beta_2 at corner 2, -(f1 + f2) at corner 0) and
+// its energy A t psi, J. 56 bytes against the full state's 400: the passes over every element
+// keep only these (the full state is rebuilt for the Hessian of the elements a step changes).
+struct ElementForces {
+  Eigen::Vector3d f1, f2;
+  double energy = 0;
+};
+
+}  // namespace
+
 struct Solver::Scratch {
-  std::vector<detail::ElementState> states_, trial_states_;  // trial_: of changed_ (line search)
+  std::vector<ElementForces> forces_;        // every element at x
+  std::vector<ElementForces> guess_forces_;  // every element at the alternative guess
+  std::vector<ElementForces> trial_forces_;  // of changed_ at trial_ (line search)
+  // The last solve's result and its elements' forces, of the model built as last_build_: an
+  // element whose corners are where they were then is not evaluated again (a body at rest, whose
+  // carried guess is the last solution, evaluates only its moving part).
+  std::vector<ElementForces> last_forces_;
+  Eigen::Matrix3Xd last_x_;
+  std::uint64_t last_build_ = 0;
+  std::vector<Eigen::Matrix3d> upper_;  // the changed elements' six upper Hessian blocks each
   std::vector<Eigen::Matrix3d> node_stiffness_, block_inverse_, blocks_;
   std::vector<std::uint8_t> free_;    // per vertex: may move in this solve
   std::vector<std::uint8_t> active_;  // per vertex: moves in this Newton step (a subset of free_)
   std::vector<std::int32_t> active_list_;        // the active vertices, ascending
   std::vector<std::int32_t> changed_, touched_;  // elements with an active corner; their corners
-  std::vector<std::uint8_t> element_mark_, node_mark_;
+  std::vector<std::int32_t> changed_slot_;       // per element: its index in changed_, or -1
+  std::vector<std::uint8_t> node_mark_;
   std::vector<std::int32_t> reached_, seed_of_;  // the active set's search (select_active)
   Eigen::Matrix3Xd predicted_, gradient_, step_, r_, z_, p_, q_, trial_, trial_direction_;
   Eigen::VectorXd inertia_weight_, node_residual_;
@@ -67,6 +91,7 @@ struct Context {
   bool dynamic = false;
   int threads = 1;
   double tolerance = 0;  // Pa: relative_tolerance x the stress scale
+  bool reuse = false;    // last_forces_ are of this model's elements at last_x_
 
   bool fixed(std::int64_t v) const {
     return in.fixed[static_cast<std::size_t>(v)] != 0 || model.node_area(std::int32_t(v)) <= 0;
@@ -84,9 +109,12 @@ void prepare_nodes(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
   const SkinMaterial& m = c.model.material();
   s.node_stiffness_.resize(static_cast<std::size_t>(c.nv));
   s.inertia_weight_.setZero(c.nv);
-  s.predicted_ =
-      c.in.predicted.cols() == c.nv ? Eigen::Matrix3Xd(c.in.predicted) : Eigen::Matrix3Xd(x);
+  if (c.in.predicted.cols() == c.nv)
+    s.predicted_ = c.in.predicted;
+  else
+    s.predicted_ = x;
   const bool normals = c.in.target_normals.cols() == c.nv;
+#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
   for (std::int64_t v = 0; v < c.nv; ++v) {
     const double area = c.model.node_area(std::int32_t(v));
     Eigen::Matrix3d k = m.attachment_stiffness * area * Eigen::Matrix3d::Identity();
@@ -107,21 +135,42 @@ void prepare_nodes(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
   }
 }
 
-detail::ElementState forces_at(const Context& c, std::int64_t e,
-                               const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+detail::ElementState state_at(const Context& c, std::int64_t e,
+                              const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
   const mesh::Face& f = c.model.element_faces()[static_cast<std::size_t>(e)];
   return detail::element_forces(c.model.elements()[static_cast<std::size_t>(e)], x.col(f[0]),
                                 x.col(f[1]), x.col(f[2]), c.model.lambda(), c.model.mu(),
                                 c.model.wrinkling());
 }
 
-// Phase 2: every element's deformation gradient, stresses and energy density (parallel over
-// elements). After a Newton step only the changed elements are evaluated again (line_search).
-void evaluate_elements(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
-  c.s.states_.resize(static_cast<std::size_t>(c.ne));
+ElementForces forces_at(const Context& c, std::int64_t e,
+                        const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+  const detail::ElementState state = state_at(c, e, x);
+  const detail::ElementRest& rest = c.model.elements()[static_cast<std::size_t>(e)];
+  return {rest.area_thickness * state.p * rest.beta.col(0),
+          rest.area_thickness * state.p * rest.beta.col(1), rest.area_thickness * state.psi};
+}
+
+// Element e's corners are bit for bit where the last solve left them: its forces are the ones
+// kept then (an element's forces depend on its corners' positions only).
+bool unmoved(const Context& c, std::int64_t e, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+  for (const std::int32_t v : c.model.element_faces()[static_cast<std::size_t>(e)])
+    if (std::memcmp(x.col(v).data(), c.s.last_x_.col(v).data(), 3 * sizeof(double)) != 0)
+      return false;
+  return true;
+}
+
+// Phase 2: every element's corner forces and energy (parallel over elements), reusing the last
+// solve's of the elements that have not moved since. After a Newton step only the changed
+// elements are evaluated again (line_search).
+void evaluate_elements(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x,
+                       std::vector<ElementForces>& forces) {
+  forces.resize(static_cast<std::size_t>(c.ne));
 #pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
   for (std::int64_t e = 0; e < c.ne; ++e)
-    c.s.states_[static_cast<std::size_t>(e)] = forces_at(c, e, x);
+    forces[static_cast<std::size_t>(e)] = c.reuse && unmoved(c, e, x)
+                                              ? c.s.last_forces_[static_cast<std::size_t>(e)]
+                                              : forces_at(c, e, x);
 }
 
 // The nodal part of Phi at node v: 1/2 d^T K d + 1/2 w |x - xp|^2 (d = x - T).
@@ -132,36 +181,40 @@ double nodal_potential(const Context& c, std::int64_t v, const Eigen::Vector3d& 
   return total;
 }
 
-// Phi at x (after Phase 1): the membrane's energy plus the free nodes' own terms.
-double total_potential(const Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+// Phi at x (after Phase 1) from its elements' forces: the membrane's energy plus the free
+// nodes' own terms, summed in a fixed order (the same total at every thread count).
+double total_potential(const Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x,
+                       const std::vector<ElementForces>& forces) {
   double total = 0;
-#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel()) \
-    reduction(+ : total)
-  for (std::int64_t e = 0; e < c.ne; ++e)
-    total += c.model.elements()[std::size_t(e)].area_thickness * forces_at(c, e, x).psi;
+  for (const ElementForces& f : forces) total += f.energy;
   for (std::int64_t v = 0; v < c.nv; ++v)
     if (c.s.free_[std::size_t(v)]) total += nodal_potential(c, v, x.col(v));
   return total;
 }
 
-// The initial guess: x, or the alternative where its Phi is lower (free nodes only).
+// The initial guess: x (whose elements' forces_ are evaluated), or the alternative where its
+// Phi is lower (free nodes only). Each guess's elements are evaluated once, and the winner's
+// forces are kept for the first gradient: one pass over the elements per guess.
 void choose_guess(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
   if (c.in.alternative_guess.cols() != c.nv || !c.in.alternative_guess.allFinite()) return;
-  Eigen::Matrix3Xd& other = c.s.trial_;
+  Solver::Scratch& s = c.s;
+  Eigen::Matrix3Xd& other = s.trial_;
   other = x;
   for (std::int64_t v = 0; v < c.nv; ++v)
-    if (c.s.free_[std::size_t(v)]) other.col(v) = c.in.alternative_guess.col(v);
-  if (total_potential(c, other) < total_potential(c, x)) x = other;
+    if (s.free_[std::size_t(v)]) other.col(v) = c.in.alternative_guess.col(v);
+  evaluate_elements(c, other, s.guess_forces_);
+  if (total_potential(c, other, s.guess_forces_) < total_potential(c, x, s.forces_)) {
+    x = other;
+    std::swap(s.forces_, s.guess_forces_);
+  }
 }
 
-// Phase 3: the gradient of Phi, g = sum_e A_e t P_e beta_a (scattered element by element:
-// sequential reads) + K_i (x_i - T_i) + w_i (x_i - xp_i), 0 at fixed nodes; and each node's
-// residual |g_i| / A_i (Pa).
-void scatter_element(Context& c, std::int64_t e, const detail::Mat32& p) {
-  const detail::ElementRest& rest = c.model.elements()[std::size_t(e)];
+// Phase 3: the gradient of Phi, g = sum_e A_e t P_e beta_a + K_i (x_i - T_i) + w_i (x_i - xp_i),
+// 0 at fixed nodes; and each node's residual |g_i| / A_i (Pa). scatter_element adds an element's
+// change of corner forces (ElementForces) f1, f2 to its corners' gradients.
+void scatter_element(Context& c, std::int64_t e, const Eigen::Vector3d& f1,
+                     const Eigen::Vector3d& f2) {
   const mesh::Face& f = c.model.element_faces()[std::size_t(e)];
-  const Eigen::Vector3d f1 = rest.area_thickness * p * rest.beta.col(0),
-                        f2 = rest.area_thickness * p * rest.beta.col(1);
   c.s.gradient_.col(f[0]) -= f1 + f2;
   c.s.gradient_.col(f[1]) += f1;
   c.s.gradient_.col(f[2]) += f2;
@@ -176,12 +229,31 @@ void node_residual(Context& c, std::int64_t v) {
   }
 }
 
+// Node v's share of the elements' forces, gathered over its incidence in ascending element
+// order: the same operations in the same order as scattering element by element, so the sum
+// does not depend on how the nodes are shared among threads.
+Eigen::Vector3d gather_element_forces(const Context& c, std::int64_t v) {
+  const auto& start = c.model.incidence_start();
+  const auto& inc = c.model.incidence();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::int32_t k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
+    const std::int32_t e = inc[std::size_t(k)] / 3, corner = inc[std::size_t(k)] % 3;
+    const ElementForces& f = c.s.forces_[std::size_t(e)];
+    if (corner == 0)
+      sum -= f.f1 + f.f2;
+    else
+      sum += corner == 1 ? f.f1 : f.f2;
+  }
+  return sum;
+}
+
 void gradient_all(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
   Solver::Scratch& s = c.s;
-  s.gradient_.setZero(3, c.nv);
+  s.gradient_.resize(3, c.nv);
   s.node_residual_.resize(c.nv);
-  for (std::int64_t e = 0; e < c.ne; ++e) scatter_element(c, e, s.states_[std::size_t(e)].p);
+#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
   for (std::int64_t v = 0; v < c.nv; ++v) {
+    s.gradient_.col(v) = gather_element_forces(c, v);
     if (s.free_[std::size_t(v)]) {
       s.gradient_.col(v) += s.node_stiffness_[std::size_t(v)] * (x.col(v) - c.in.targets.col(v));
       if (c.dynamic) s.gradient_.col(v) += s.inertia_weight_[v] * (x.col(v) - s.predicted_.col(v));
@@ -243,15 +315,15 @@ void mark_changed(Context& c) {
   const auto& start = c.model.incidence_start();
   const auto& inc = c.model.incidence();
   const auto& faces = c.model.element_faces();
-  s.element_mark_.assign(std::size_t(c.ne), 0);
+  s.changed_slot_.assign(std::size_t(c.ne), -1);
   s.node_mark_.assign(std::size_t(c.nv), 0);
   s.changed_.clear();
   s.touched_.clear();
   for (const std::int32_t v : s.active_list_)
     for (std::int32_t k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
       const std::int32_t e = inc[std::size_t(k)] / 3;
-      if (s.element_mark_[std::size_t(e)]) continue;
-      s.element_mark_[std::size_t(e)] = 1;
+      if (s.changed_slot_[std::size_t(e)] >= 0) continue;
+      s.changed_slot_[std::size_t(e)] = std::int32_t(s.changed_.size());
       s.changed_.push_back(e);
       for (const std::int32_t u : faces[std::size_t(e)])
         if (!s.node_mark_[std::size_t(u)]) {
@@ -261,39 +333,56 @@ void mark_changed(Context& c) {
     }
 }
 
-// Phase 5: assemble the Hessian approximation's 3 x 3 blocks of the active rows from the
-// changed elements (those with an active corner), each element's six distinct blocks computed
-// once and added to the active rows they belong to; then the nodal attachment and inertia terms
-// on the diagonal, and the diagonal blocks' inverses (both preconditioners use them). Blocks of
-// inactive rows are neither written nor read.
-void assemble(Context& c) {
+// Phase 5a: each changed element's six distinct Hessian blocks (a <= b) at x, into upper_
+// (parallel over the elements; the element's full state is rebuilt here, not kept).
+void element_hessians(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
   Solver::Scratch& s = c.s;
+  const auto nc = static_cast<std::int64_t>(s.changed_.size());
+  s.upper_.resize(std::size_t(6 * nc));
+#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
+  for (std::int64_t k = 0; k < nc; ++k) {
+    const std::int32_t e = s.changed_[std::size_t(k)];
+    detail::ElementState state = state_at(c, e, x);
+    detail::add_hessian_terms(state);
+    detail::hessian_upper_blocks(c.model.elements()[std::size_t(e)], state, c.model.lambda(),
+                                 c.model.mu(), &s.upper_[std::size_t(6 * k)]);
+  }
+}
+
+// Phase 5b: the Hessian approximation's 3 x 3 blocks of the active rows, each row gathered from
+// its elements (all changed, as it is active) in ascending element order, so that the sums do
+// not depend on the thread count; then the nodal attachment and inertia terms on the diagonal,
+// and the diagonal blocks' inverses (both preconditioners use them). Blocks of inactive rows
+// are neither written nor read.
+void assemble(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+  Solver::Scratch& s = c.s;
+  element_hessians(c, x);
   const auto& element_block = c.model.element_block();
   const auto& diagonal = c.model.diagonal_block();
   const auto& row_start = c.model.block_start();
+  const auto& start = c.model.incidence_start();
+  const auto& inc = c.model.incidence();
   s.blocks_.resize(c.model.block_column().size());
   s.block_inverse_.resize(static_cast<std::size_t>(c.nv));
-  for (const std::int32_t v : s.active_list_)
+  constexpr int kPair[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};  // (a, b) -> upper_ index
+  const auto na = static_cast<std::int64_t>(s.active_list_.size());
+#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
+  for (std::int64_t i = 0; i < na; ++i) {
+    const std::int32_t v = s.active_list_[std::size_t(i)];
     for (std::int32_t j = row_start[std::size_t(v)]; j < row_start[std::size_t(v) + 1]; ++j)
       s.blocks_[std::size_t(j)].setZero();
-  constexpr int kPair[6][2] = {{0, 0}, {0, 1}, {0, 2}, {1, 1}, {1, 2}, {2, 2}};
-  for (const std::int32_t e : s.changed_) {
-    detail::ElementState& state = s.states_[std::size_t(e)];
-    detail::add_hessian_terms(state);
-    Eigen::Matrix3d upper[6];
-    detail::hessian_upper_blocks(c.model.elements()[std::size_t(e)], state, c.model.lambda(),
-                                 c.model.mu(), upper);
-    const mesh::Face& f = c.model.element_faces()[std::size_t(e)];
-    const auto block = [&](int a, int b) -> Eigen::Matrix3d& {
-      return s.blocks_[std::size_t(element_block[std::size_t(9 * e + 3 * a + b)])];
-    };
-    for (int k = 0; k < 6; ++k) {
-      const int a = kPair[k][0], b = kPair[k][1];
-      if (s.active_[std::size_t(f[a])]) block(a, b) += upper[k];
-      if (a != b && s.active_[std::size_t(f[b])]) block(b, a) += upper[k].transpose();
+    for (std::int32_t k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
+      const std::int32_t e = inc[std::size_t(k)] / 3, a = inc[std::size_t(k)] % 3;
+      const Eigen::Matrix3d* upper = &s.upper_[std::size_t(6 * s.changed_slot_[std::size_t(e)])];
+      for (int b = 0; b < 3; ++b) {
+        Eigen::Matrix3d& block =
+            s.blocks_[std::size_t(element_block[std::size_t(9 * e + 3 * a + b)])];
+        if (a <= b)
+          block += upper[kPair[a][b]];
+        else
+          block += upper[kPair[a][b]].transpose();
+      }
     }
-  }
-  for (const std::int32_t v : s.active_list_) {
     Eigen::Matrix3d& k = s.blocks_[std::size_t(diagonal[std::size_t(v)])];
     k += s.node_stiffness_[std::size_t(v)];
     if (c.dynamic) k.diagonal().array() += s.inertia_weight_[v];
@@ -441,34 +530,33 @@ int conjugate_gradients(Context& c) {
 // Phi(x + alpha step) - Phi(x): only the changed elements and the active nodes' own terms
 // differ, so the difference is summed over them (cheap, and free of the cancellation that
 // comparing two totals of the whole mesh suffers near the solution). The trial elements'
-// states are kept for the accepted step.
+// forces are kept for the accepted step.
 double potential_change(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x, double alpha) {
   Solver::Scratch& s = c.s;
   for (const std::int32_t v : s.active_list_) s.trial_.col(v) = x.col(v) + alpha * s.step_.col(v);
   const auto nc = static_cast<std::int64_t>(s.changed_.size());
-  s.trial_states_.resize(std::size_t(nc));
-  double change = 0;
-#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel()) \
-    reduction(+ : change)
-  for (std::int64_t k = 0; k < nc; ++k) {
-    const std::int32_t e = s.changed_[std::size_t(k)];
-    s.trial_states_[std::size_t(k)] = forces_at(c, e, s.trial_);
-    change += c.model.elements()[std::size_t(e)].area_thickness *
-              (s.trial_states_[std::size_t(k)].psi - s.states_[std::size_t(e)].psi);
-  }
+  s.trial_forces_.resize(std::size_t(nc));
+#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
+  for (std::int64_t k = 0; k < nc; ++k)
+    s.trial_forces_[std::size_t(k)] = forces_at(c, s.changed_[std::size_t(k)], s.trial_);
+  double change = 0;  // summed in a fixed order: the same at every thread count
+  for (std::int64_t k = 0; k < nc; ++k)
+    change += s.trial_forces_[std::size_t(k)].energy -
+              s.forces_[std::size_t(s.changed_[std::size_t(k)])].energy;
   for (const std::int32_t v : s.active_list_)
     change += nodal_potential(c, v, s.trial_.col(v)) - nodal_potential(c, v, x.col(v));
   return change;
 }
 
-// The step to trial_ is taken: x, the changed elements' states, and the gradient updated by
+// The step to trial_ is taken: x, the changed elements' forces, and the gradient updated by
 // the change of each changed element's forces and of the active nodes' own terms.
 void accept_step(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
   Solver::Scratch& s = c.s;
   for (std::size_t k = 0; k < s.changed_.size(); ++k) {
     const std::int32_t e = s.changed_[k];
-    scatter_element(c, e, s.trial_states_[k].p - s.states_[std::size_t(e)].p);
-    s.states_[std::size_t(e)] = s.trial_states_[k];
+    ElementForces& now = s.forces_[std::size_t(e)];
+    scatter_element(c, e, s.trial_forces_[k].f1 - now.f1, s.trial_forces_[k].f2 - now.f2);
+    now = s.trial_forces_[k];
   }
   for (const std::int32_t v : s.active_list_) {
     const Eigen::Vector3d dx = s.trial_.col(v) - x.col(v);
@@ -480,8 +568,8 @@ void accept_step(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
 }
 
 // Phase 7: backtracking (Armijo) line search on Phi; on success x, the changed elements'
-// states and the touched nodes' gradients are those of the new positions. Returns false if no
-// decrease was found (x and the states are left as they were).
+// forces and the touched nodes' gradients are those of the new positions. Returns false if no
+// decrease was found (x and the forces are left as they were).
 bool line_search(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
   Solver::Scratch& s = c.s;
   double slope = 0;
@@ -525,12 +613,14 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
     require_cols(input.target_velocities, nv, false, "target_velocities");
   }
   if (!x.allFinite()) throw std::invalid_argument("membrane solve: x holds a non-finite value");
+  c.reuse = model.build_id() != 0 && s.last_build_ == model.build_id() && s.last_x_.cols() == nv &&
+            s.last_forces_.size() == std::size_t(c.ne);
   prepare_nodes(c, x);
   s.free_.resize(std::size_t(nv));
   for (Eigen::Index v = 0; v < nv; ++v) s.free_[std::size_t(v)] = !c.fixed(v);
+  evaluate_elements(c, x, s.forces_);
   choose_guess(c, x);
   s.trial_ = x;
-  evaluate_elements(c, x);
   gradient_all(c, x);
   SolveReport report;
   for (;; ++report.newton_iterations) {
@@ -544,10 +634,13 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
     if (report.newton_iterations == settings.max_newton_iterations) break;
     select_active(c, report.residual, x);
     mark_changed(c);
-    assemble(c);
+    assemble(c, x);
     report.cg_iterations += conjugate_gradients(c);
     if (!line_search(c, x)) break;
   }
+  s.last_x_ = x;  // forces_ are of x's elements (line_search keeps them so)
+  std::swap(s.last_forces_, s.forces_);
+  s.last_build_ = model.build_id();
   return report;
 }
 

@@ -55,6 +55,9 @@ class Model {
   std::int32_t vertex_count() const { return static_cast<std::int32_t>(node_area_.size()); }
   std::int32_t element_count() const { return static_cast<std::int32_t>(elements_.size()); }
   std::int32_t degenerate_faces() const { return degenerate_; }
+  /// Distinct for every build() in the process (0 before the first): a model with the same id
+  /// has the same elements, so what a solver computed of them may be reused.
+  std::uint64_t build_id() const { return build_id_; }
   const SkinMaterial& material() const { return material_; }
   /// The law's parameters, as the kernel (detail/cst_kernel.hpp) takes them, Pa: stvk the
   /// plane-stress Lame constants; neo_hookean mu = E / 3 and lambda 0 (unused).
@@ -97,6 +100,7 @@ class Model {
   std::vector<std::int32_t> block_start_, block_column_, element_block_, diagonal_block_;
   void build_block_pattern();
   std::int32_t degenerate_ = 0;
+  std::uint64_t build_id_ = 0;
 };
 
 }  // namespace conform::membrane
