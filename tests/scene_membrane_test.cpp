@@ -94,6 +94,23 @@ TEST(SceneMembraneSlit, AtItsDefaultsSettlesWithin2PercentOfLefm) {
   EXPECT_FALSE(m.contains("foundation_w_max"));  // no foundation at the defaults
 }
 
+TEST(SceneMembraneSlit, TheStVKLawAlsoSettlesWithin2PercentOfLefm) {
+  const Json s = run("membrane-slit", "--set material.law=stvk", "slit_stvk");
+  ASSERT_TRUE(s.is_object());
+  const Json& set = s["settings"];
+  EXPECT_EQ(set["material"]["law"], "stvk");
+  const double lefm = 4 * set["material"]["prestress"][1].get<double>() * 0.5 *
+                      set["slit"]["length"].get<double>() /
+                      set["material"]["youngs_modulus"].get<double>();
+  EXPECT_NEAR(s["metrics"]["w_max"].get<double>() / lefm, 1.0, 0.02);
+}
+
+// Poisson's ratio at small strain: the StVK law's own, 1/2 for the (incompressible)
+// neo-Hookean law.
+double small_strain_nu(const Json& material) {
+  return material["law"] == "stvk" ? material["poisson_ratio"].get<double>() : 0.5;
+}
+
 // The membrane on an elastic foundation k (plane stress): a straight edge cut under the
 // pre-stress sigma normal to it retracts by u0 = sigma l / E'' and decays as exp(-d / l),
 // l = sqrt(E'' t / k), E'' = E / (1 - nu^2).
@@ -102,7 +119,7 @@ struct FoundationRef {
 };
 FoundationRef foundation_ref(const Json& settings) {
   const Json& mat = settings["material"];
-  const double e = mat["youngs_modulus"].get<double>(), nu = mat["poisson_ratio"].get<double>();
+  const double e = mat["youngs_modulus"].get<double>(), nu = small_strain_nu(mat);
   const double e2 = e / (1 - nu * nu);
   return {e2, std::sqrt(e2 * mat["thickness"].get<double>() /
                         mat["attachment_stiffness"].get<double>())};
@@ -180,13 +197,81 @@ TEST(SceneMembraneSlit, PrestressIsSigmaXxAndSigmaYyWithNoOtherKey) {
   EXPECT_TRUE(along["metrics"]["settled"].get<bool>());
 }
 
+// The fibre-reinforced law at small strain is an orthotropic plate (incompressible matrix,
+// mu = E / 3, with 4 k1 more along the fibres): c11 = 4 mu + 4 k1, c22 = 4 mu, c12 = 2 mu,
+// c66 = mu. A Griffith crack along material axis 1 opens by 4 sigma_n a H, with H of Sih, Paris
+// and Irwin (1965) from the compliances a_ij of the crack's axes:
+// H = sqrt(a11 a22 / 2) sqrt(sqrt(a22 / a11) + (2 a12 + a66) / (2 a11)).
+double orthotropic_crack_h(const Json& material, bool crack_along_fibres) {
+  const double mu = material["youngs_modulus"].get<double>() / 3;
+  const double c_fibre = 4 * mu + 4 * material["fibre_stiffness"].get<double>();
+  const double c_across = 4 * mu, c12 = 2 * mu;
+  const double det = c_fibre * c_across - c12 * c12;
+  const double a_fibre = c_across / det, a_across = c_fibre / det, a12 = -c12 / det, a66 = 1 / mu;
+  const double a11 = crack_along_fibres ? a_fibre : a_across;
+  const double a22 = crack_along_fibres ? a_across : a_fibre;
+  return std::sqrt(a11 * a22 / 2) * std::sqrt(std::sqrt(a22 / a11) + (2 * a12 + a66) / (2 * a11));
+}
+
+// The slit's opening against the orthotropic plate's, with fibres along x (the scene's
+// prestress_axis) and the slit at angle_deg (0: along the fibres, 90: across them).
+double fibre_slit_over_lefm(const std::string& prestress, int angle_deg, const std::string& tag) {
+  const Json s = run("membrane-slit",
+                     "--set material.law=fibre-reinforced --set material.prestress=" + prestress +
+                         " --set slit.angle_deg=" + std::to_string(angle_deg),
+                     tag);
+  if (!s.is_object()) return 0;
+  const Json& set = s["settings"];
+  const bool along_fibres = angle_deg == 0;
+  const double sigma_n = set["material"]["prestress"][along_fibres ? 1 : 0].get<double>();
+  const double w = 4 * sigma_n * 0.5 * set["slit"]["length"].get<double>() *
+                   orthotropic_crack_h(set["material"], along_fibres);
+  const Json& m = s["metrics"];
+  EXPECT_NEAR(m["lefm_w_max"].get<double>(), w, 1e-12 * w);
+  EXPECT_TRUE(m["settled"].get<bool>());
+  return m["w_max"].get<double>() / w;
+}
+
+TEST(SceneMembraneSlit, TheFibreReinforcedLawOpensAsAnOrthotropicPlate) {
+  // Where the fibres stay stretched around the slit, the law is the orthotropic plate. Along
+  // the fibres they stay stretched at equibiaxial pre-stress; across them, the crack faces'
+  // stress along the slit is about sigma_parallel - sigma_n, and sigma_xx > sigma_yy leaves the
+  // fibres (along x, across the faces) stretched by Poisson's effect.
+  EXPECT_NEAR(fibre_slit_over_lefm("[400,400]", 0, "fibre_along"), 1.0, 0.03);
+  EXPECT_NEAR(fibre_slit_over_lefm("[800,400]", 90, "fibre_across"), 1.0, 0.03);
+}
+
+TEST(SceneMembraneSlit, FibresThatGoSlackCarryNoCompression) {
+  // Across the fibres with sigma_yy >= sigma_xx the fibres near the faces shorten below their
+  // rest length and go slack (the law has no fibre term for I4 < 1): the slit opens more than
+  // the plate whose fibres would resist compression, the more so the more they shorten.
+  const double equal = fibre_slit_over_lefm("[400,400]", 90, "fibre_slack_1");
+  const double more = fibre_slit_over_lefm("[400,800]", 90, "fibre_slack_2");
+  EXPECT_GT(equal, 1.02);
+  EXPECT_GT(more, equal + 0.1);
+}
+
+TEST(SceneMembraneSlit, RefusesAFibreLawSlitOffItsAxes) {
+  const fs::path conform = fs::path(CONFORM_BINARY_DIR) / "scenes" / "conform";
+  const fs::path dir = fs::path(testing::TempDir()) / "conform_membrane_scene_fibre_45";
+  fs::remove_all(dir);
+  const std::string cmd = conform.string() + " run membrane-slit --out " + dir.string() +
+                          " --set material.law=fibre-reinforced --set slit.angle_deg=45 > " +
+                          dir.string() + ".log 2>&1";
+  EXPECT_NE(std::system(cmd.c_str()), 0);
+  std::ifstream log(dir.string() + ".log");
+  const std::string text((std::istreambuf_iterator<char>(log)), {});
+  EXPECT_NE(text.find("slit.angle_deg"), std::string::npos) << text;
+  EXPECT_FALSE(fs::exists(dir / "summary.json"));
+}
+
 // Kirsch (plane stress, small strain): a round hole made in a plate under [sxx, syy] grows its
 // semi-axes by (2 sxx - (1 - nu) syy) / E along x and the same swapped along y.
 void expect_kirsch(const Json& s, double sxx, double syy, double tolerance) {
   ASSERT_TRUE(s.is_object());
   const Json& m = s["metrics"];
   const double e = s["settings"]["material"]["youngs_modulus"].get<double>();
-  const double nu = s["settings"]["material"]["poisson_ratio"].get<double>();
+  const double nu = small_strain_nu(s["settings"]["material"]);
   const double kx = (2 * sxx - (1 - nu) * syy) / e, ky = (2 * syy - (1 - nu) * sxx) / e;
   EXPECT_NEAR(m["kirsch_growth_x"].get<double>(), kx, 1e-12 * std::abs(kx));
   EXPECT_NEAR(m["kirsch_growth_y"].get<double>(), ky, 1e-12 * std::abs(ky));

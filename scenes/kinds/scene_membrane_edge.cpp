@@ -112,7 +112,11 @@ class MembraneEdge final : public Scene {
     if (!(k > 0))
       throw SceneError("material.attachment_stiffness", std::to_string(k),
                        "must be > 0: membrane-edge measures the sheet on its foundation");
-    const double l = foundation(material_.skin).decay_length;
+    if (!material_axes_aligned(material_.skin, Eigen::Vector3d::UnitX()))
+      throw SceneError("material.prestress_axis", "",
+                       "membrane-edge's closed form needs the cut's normal (x) along a material "
+                       "axis of the anisotropic law (the axis along x or y)");
+    const double l = foundation(material_.skin, Eigen::Vector3d::UnitX()).decay_length;
     if (options_.element_size > 0.5 * l)
       throw SceneError("sheet.resolution", std::to_string(options_.element_size),
                        "at most half the decay length sqrt(E'' t / k) = " + std::to_string(l));
@@ -237,8 +241,8 @@ Json MembraneEdge::summarise(RunOutput& out, const EdgeProfile& p,
                              const membrane::SolveReport& last, double physics_ms, double loop_s,
                              std::int32_t nodes) {
   const CommonSettings& c = common_;
-  const Foundation f = foundation(material_.skin);
-  const double sigma = material_.skin.prestress[0];  // normal to the cut x = 0
+  const Foundation f = foundation(material_.skin, Eigen::Vector3d::UnitX());
+  const double sigma = prestress_across(material_.skin, Eigen::Vector3d::UnitX());  // cut x = 0
   const double u0 = f.retraction(sigma), l = f.decay_length;
   {
     RunOutput::Csv csv = out.open_csv(

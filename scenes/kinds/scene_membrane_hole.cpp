@@ -108,6 +108,10 @@ class MembraneHole final : public Scene {
     if (material_.model != bullet::MaterialModel::membrane)
       throw SceneError("material.model", "\"bullet_links\"",
                        "membrane-hole measures the membrane; Bullet's links have no modulus");
+    if (!membrane::small_strain_moduli(material_.skin).isotropic())
+      throw SceneError("material.law", "\"fibre-reinforced\"",
+                       "membrane-hole compares with Kirsch's solution for an isotropic plate; "
+                       "the fibre-reinforced law is anisotropic");
   }
 
   Json run(RunOutput& out) override {
@@ -154,8 +158,11 @@ class MembraneHole final : public Scene {
     if (!drilled)
       throw std::runtime_error("membrane-hole: the run ended (" + std::to_string(c.steps * c.dt) +
                                " s) before hole.at = " + std::to_string(at_) + " s");
-    const double sxx = material_.skin.prestress[0], syy = material_.skin.prestress[1];
-    const double e = material_.skin.youngs_modulus, nu = material_.skin.poisson_ratio;
+    // The isotropic law's small-strain E and nu (nu = 1/2 for the neo-Hookean law).
+    const membrane::PlaneModuli m = membrane::small_strain_moduli(material_.skin);
+    const double nu = m.c12 / m.c22, e = m.c11 - m.c12 * nu;
+    const double sxx = prestress_across(material_.skin, Eigen::Vector3d::UnitX()),
+                 syy = prestress_across(material_.skin, Eigen::Vector3d::UnitY());
     const double kx = (2 * sxx - (1 - nu) * syy) / e, ky = (2 * syy - (1 - nu) * sxx) / e;
     Json metrics = {{"hole_growth_x", fit.growth_x},
                     {"hole_growth_y", fit.growth_y},

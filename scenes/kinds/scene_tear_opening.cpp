@@ -38,7 +38,7 @@ constexpr const char* kTearOpeningJson = R"json({
   "pose": { "elbow_deg": 0, "flex_deg": 0, "flex_at": 1.5, "flex_duration": 0.5 },
   "material": {
     "model": "membrane",
-    "youngs_modulus": 420000, "poisson_ratio": 0.48, "thickness": 0.0015, "areal_density": 1.65,
+    "law": "neo-hookean", "youngs_modulus": 420000, "poisson_ratio": 0.48, "thickness": 0.0015, "areal_density": 1.65,
     "prestress": [80800, 80800], "prestress_axis": [0, 0, 1],
     "attachment_stiffness": 400000, "attachment_normal_stiffness": 40000000,
     "attachment_damping": 1600, "wrinkling": true, "relative_tolerance": 0.0012,

@@ -58,6 +58,33 @@ void SkinMaterial::validate() const {
           attachment_damping, ">= 0 Pa s/m");
 }
 
+bool PlaneModuli::isotropic() const {
+  const double scale = std::max(std::abs(c11), std::abs(c22));
+  return std::abs(c11 - c22) <= 1e-12 * scale && std::abs(c12 + 2 * c66 - c11) <= 1e-12 * scale;
+}
+
+double PlaneModuli::along(double cos_theta) const {
+  const double c2 = cos_theta * cos_theta, s2 = 1 - c2;
+  return c11 * c2 * c2 + 2 * (c12 + 2 * c66) * c2 * s2 + c22 * s2 * s2;
+}
+
+PlaneModuli small_strain_moduli(const SkinMaterial& material) {
+  PlaneModuli m;
+  if (!hyperelastic(material.law)) {
+    const double e = material.youngs_modulus, nu = material.poisson_ratio;
+    m.c11 = m.c22 = e / (1 - nu * nu);
+    m.c12 = nu * m.c11;
+    m.c66 = e / (2 * (1 + nu));
+    return m;
+  }
+  const double mu = material.neo_hookean_mu();
+  m.c11 = m.c22 = 4 * mu;
+  m.c12 = 2 * mu;
+  m.c66 = mu;
+  if (material.law == SkinMaterial::Law::fibre_reinforced) m.c11 += 4 * material.fibre_stiffness;
+  return m;
+}
+
 double equibiaxial_prestress(const SkinMaterial& material, double prestrain) {
   return material.youngs_modulus * prestrain / (1 - material.poisson_ratio);
 }

@@ -57,8 +57,8 @@ struct SkinMaterial {
   ///         (I4 > 1), none where they are not; pre-stretched so that the bind state's stress is
   ///         still `prestress` (an isotropic pre-stress then needs less stretch along the fibres).
   enum class Law { stvk, neo_hookean, fibre_reinforced };
-  /// Default stvk.
-  Law law = Law::stvk;
+  /// Default neo_hookean: skin runs at 10-20 % pre-strain, outside stvk's small-strain range.
+  Law law = Law::neo_hookean;
   /// Young's modulus E, Pa, > 0 (skin in vivo: 0.1-1 MPa; default 0.42 MPa).
   double youngs_modulus = 0.42e6;
   /// The fibres' stiffness k1 of Law::fibre_reinforced, Pa, finite and >= 0 (default 79.8 kPa,
@@ -67,7 +67,8 @@ struct SkinMaterial {
   /// The fibres' stiffening exponent k2 of Law::fibre_reinforced, dimensionless, in (0, 100]
   /// (default 1.285; see the sources above). Unused by the other laws.
   double fibre_nonlinearity = 1.285;
-  /// Poisson's ratio nu of the membrane (plane stress), in [0, 0.5) (default 0.48).
+  /// Poisson's ratio nu of the membrane (plane stress), in [0, 0.5) (default 0.48); the stvk
+  /// law's only (the neo-Hookean laws are incompressible, nu = 1/2).
   double poisson_ratio = 0.48;
   /// Thickness t, m, > 0 (default 1.5 mm).
   double thickness = 1.5e-3;
@@ -130,6 +131,27 @@ struct SkinMaterial {
 inline bool hyperelastic(SkinMaterial::Law law) {
   return law != SkinMaterial::Law::stvk;
 }
+
+/// The law's plane-stress moduli at small strain about the unstrained state, Pa, in the axes
+/// of the pre-stress (1: along the first principal pre-stress, where the fibres lie; 2: across
+/// it, in the face): sigma_11 = c11 e_11 + c12 e_22, sigma_22 = c12 e_11 + c22 e_22,
+/// sigma_12 = c66 gamma_12 (gamma_12 = 2 e_12).
+///   stvk:             c11 = c22 = E / (1 - nu^2), c12 = nu c11, c66 = E / (2 (1 + nu));
+///   neo_hookean:      incompressible plane stress (nu = 1/2, mu = E / 3): 4 mu, 4 mu, 2 mu, mu;
+///   fibre_reinforced: the same with 4 k1 more on c11 (psi_f = 2 k1 e_11^2 to second order, for
+///                     fibres in tension, e_11 > 0), so that the uniaxial modulus along the
+///                     fibres is E + 4 k1.
+/// The pre-stress's own (geometric) stiffness, O(sigma / E), is left out: these are the moduli
+/// of the closed forms that the membrane checks compare with at sigma / E ~ 1e-3.
+struct PlaneModuli {
+  double c11 = 0, c22 = 0, c12 = 0, c66 = 0;
+  /// The same moduli in every direction of the plane (c11 = c22 = c12 + 2 c66).
+  bool isotropic() const;
+  /// The modulus of a uniaxial strain along a direction at angle theta (cos c, sin s) to axis 1:
+  /// c11 c^4 + 2 (c12 + 2 c66) c^2 s^2 + c22 s^4, Pa (E'' along an axis, e.g. across an edge).
+  double along(double cos_theta) const;
+};
+PlaneModuli small_strain_moduli(const SkinMaterial& material);
 
 /// The pre-stress of an equibiaxial pre-strain eps: sigma = E eps / (1 - nu), Pa (the StVK
 /// law's small-strain relation).
