@@ -5,6 +5,7 @@
 // is a few seconds of simulated time (well under a second of wall time in Release).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -93,10 +94,11 @@ TEST(SceneTearOpening, OpensByPhysicsUnderPrestressOnly) {
   EXPECT_EQ(m["physics"]["unconverged_substeps"].get<int>(), 0);
   EXPECT_LE(m["physics"]["residual"].get<double>(), 100.0);  // Pa, the default tolerance
   // After the stroke the elbow flexes 90 degrees (1.5-2 s): the skin over it stretches and the
-  // physical wound gapes wider (+5 % at resolution 1), converged in every substep (the skin
-  // wrinkles at the inner elbow); the geometric opening stays as step 6 made it.
+  // physical wound gapes wider (+1.4 % at resolution 1 under the neo-Hookean law, +5 % under
+  // StVK), converged in every substep (the skin wrinkles at the inner elbow); the geometric
+  // opening stays as step 6 made it.
   EXPECT_GT(m["physics"]["max_opening"].get<double>(),
-            1.02 * m["physics"]["max_opening_before_flex"].get<double>());
+            1.007 * m["physics"]["max_opening_before_flex"].get<double>());
   EXPECT_LE(m["physics"]["residual_max"].get<double>(), 100.0);
 
   const Json slack =
@@ -105,6 +107,29 @@ TEST(SceneTearOpening, OpensByPhysicsUnderPrestressOnly) {
   EXPECT_GT(slack["metrics"]["physics"]["tear_points"].get<int>(), 20);
   EXPECT_LT(slack["metrics"]["physics"]["max_opening"].get<double>(),
             0.2 * m["physics"]["max_opening"].get<double>());
+}
+
+// The tear runs along the forearm. With the pre-stress [2 sigma, sigma] around the limb its
+// lips feel 2 sigma, along the limb sigma: on its foundation the long tear opens by
+// 2 sigma_n l / E'' (l = sqrt(E'' t / k), E'' = 4 E / 3 for the incompressible neo-Hookean law),
+// twice as wide around as along. sigma / E = 0.02 keeps it in the formula's small-strain range.
+TEST(SceneTearOpening, ThePrestressAroundTheLimbOpensTheTearAlongIt) {
+  const std::string common =
+      "--set duration=1.5 --set outputs.frames_every=0 --set material.prestress=[16160,8080] ";
+  const Json along =
+      run("tear-opening", common + "--set material.prestress_field=along-bones", "field_along");
+  const Json around =
+      run("tear-opening", common + "--set material.prestress_field=around-bones", "field_around");
+  ASSERT_TRUE(along.is_object() && around.is_object());
+  const Json& mat = along["settings"]["material"];
+  ASSERT_EQ(mat["law"], "neo-hookean");
+  const double e2 = 4 * mat["youngs_modulus"].get<double>() / 3;
+  const double l =
+      std::sqrt(e2 * mat["thickness"].get<double>() / mat["attachment_stiffness"].get<double>());
+  const auto w = [](const Json& s) { return s["metrics"]["physics"]["max_opening"].get<double>(); };
+  EXPECT_NEAR(w(along) / (2 * 8080 * l / e2), 1.0, 0.03);    // measured 0.982
+  EXPECT_NEAR(w(around) / (2 * 16160 * l / e2), 1.0, 0.03);  // measured 0.987
+  EXPECT_NEAR(w(around) / w(along), 2.0, 0.04);              // measured 2.010
 }
 
 TEST(SceneCut, PiecesKeepSimulatingAndTheHandFollowsItsBones) {
@@ -206,6 +231,21 @@ TEST(SceneCharacter, SeamCopiesWeightedApartWeldWithTheirMeanAndStayClosed) {
   EXPECT_EQ(open["kept_apart_vertices"].get<int>(), 7);
   EXPECT_EQ(open["open_positions"].get<int>(), 7);
   EXPECT_GT(open["max_gap_rel"].get<double>(), 1e-3);
+}
+
+TEST(SceneCharacter, SeparateObjectsThatTouchAreNotSeams) {
+  // Collada/anims_with_full_rotations_between_keys.DAE: boxes, each its own mesh on its own
+  // bone, share 8 corner positions. They part as they turn (the seam measure read 1.93 of the
+  // diagonal when it counted them), but they are separate objects, not an open seam.
+  const std::string file =
+      "/usr/share/assimp/models/Collada/anims_with_full_rotations_between_keys.DAE";
+  if (!fs::exists(file)) GTEST_SKIP() << "assimp-testmodels is not installed";
+  const Json s = run("character", "--set model.file=" + file, "character_boxes");
+  ASSERT_TRUE(s.is_object());
+  const Json& seams = s["metrics"]["seams"];
+  EXPECT_EQ(seams["touching_positions"].get<int>(), 8);
+  EXPECT_EQ(seams["open_positions"].get<int>(), 0);
+  EXPECT_LE(seams["max_gap_rel"].get<double>(), 1e-6);
 }
 
 }  // namespace
