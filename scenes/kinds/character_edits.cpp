@@ -218,32 +218,86 @@ Json apply_drill(bullet::SkinnedSoftBody& body, const BindPose& bind, const Dril
   return event;
 }
 
-SeamGap::SeamGap(const Eigen::Matrix3Xd& rest, std::span<const std::int32_t> vertex_map) {
+namespace {
+
+// Union-find over file vertices (path halving).
+struct Pieces {
+  std::vector<std::int32_t> parent;
+  explicit Pieces(std::int32_t n) : parent(static_cast<std::size_t>(n)) {
+    std::iota(parent.begin(), parent.end(), 0);
+  }
+  std::int32_t find(std::int32_t v) {
+    while (parent[std::size_t(v)] != v)
+      v = parent[std::size_t(v)] = parent[std::size_t(parent[std::size_t(v)])];
+    return v;
+  }
+  void join(std::int32_t a, std::int32_t b) { parent[std::size_t(find(a))] = find(b); }
+};
+
+using RestKey = std::array<double, 3>;
+
+// The file vertices grouped by rest position (groups of one left out), each sorted.
+std::vector<std::vector<std::int32_t>> coincident_groups(const Eigen::Matrix3Xd& rest) {
   std::vector<std::int32_t> order(static_cast<std::size_t>(rest.cols()));
   std::iota(order.begin(), order.end(), 0);
-  const auto key = [&](std::int32_t v) {
-    return std::array<double, 3>{rest(0, v), rest(1, v), rest(2, v)};
-  };
+  const auto key = [&](std::int32_t v) { return RestKey{rest(0, v), rest(1, v), rest(2, v)}; };
   std::sort(order.begin(), order.end(),
             [&](std::int32_t a, std::int32_t b) { return key(a) < key(b); });
-  const auto node = [&](std::int32_t v) {
-    return vertex_map.empty() ? v : vertex_map[static_cast<std::size_t>(v)];
-  };
-  starts_.push_back(0);
+  std::vector<std::vector<std::int32_t>> groups;
   for (std::size_t i = 0; i < order.size();) {
     std::size_t j = i + 1;
     while (j < order.size() && key(order[j]) == key(order[i])) ++j;
-    if (j - i > 1) {  // a seam: several file vertices at one rest position
-      std::vector<std::int32_t> group;
-      for (std::size_t k = i; k < j; ++k) group.push_back(node(order[k]));
-      std::sort(group.begin(), group.end());
-      group.erase(std::unique(group.begin(), group.end()), group.end());
-      open_ += group.size() > 1;
-      file_vertices_ += static_cast<std::int32_t>(j - i);
-      nodes_.insert(nodes_.end(), group.begin(), group.end());
-      starts_.push_back(static_cast<std::int32_t>(nodes_.size()));
-    }
+    if (j - i > 1)
+      groups.emplace_back(order.begin() + std::ptrdiff_t(i), order.begin() + std::ptrdiff_t(j));
     i = j;
+  }
+  return groups;
+}
+
+}  // namespace
+
+SeamGap::SeamGap(const Eigen::Matrix3Xd& rest, std::span<const mesh::Face> faces,
+                 std::span<const std::int32_t> mesh_of, std::span<const std::int32_t> vertex_map) {
+  const auto node = [&](std::int32_t v) {
+    return vertex_map.empty() ? v : vertex_map[static_cast<std::size_t>(v)];
+  };
+  const std::vector<std::vector<std::int32_t>> groups = coincident_groups(rest);
+  Pieces pieces(static_cast<std::int32_t>(rest.cols()));
+  for (const mesh::Face& f : faces) pieces.join(f[0], f[1]), pieces.join(f[0], f[2]);
+  std::vector<std::int32_t> first_of_node(static_cast<std::size_t>(rest.cols()), -1);
+  for (std::int32_t v = 0; v < rest.cols(); ++v) {  // the weld's joins
+    std::int32_t& first = first_of_node[static_cast<std::size_t>(node(v))];
+    if (first < 0)
+      first = v;
+    else
+      pieces.join(first, v);
+  }
+  for (const auto& g : groups)  // one position within one file mesh
+    for (std::size_t k = 1; k < g.size(); ++k)
+      if (mesh_of[std::size_t(g[k])] == mesh_of[std::size_t(g[0])]) pieces.join(g[0], g[k]);
+  starts_.push_back(0);
+  for (const auto& g : groups) {
+    std::vector<std::int32_t> group_pieces;
+    for (const std::int32_t v : g) group_pieces.push_back(pieces.find(v));
+    std::sort(group_pieces.begin(), group_pieces.end());
+    touching_ += std::unique(group_pieces.begin(), group_pieces.end()) - group_pieces.begin() > 1;
+    std::vector<std::pair<std::int32_t, std::int32_t>> by_piece;  // (piece, body vertex)
+    for (const std::int32_t v : g) by_piece.emplace_back(pieces.find(v), node(v));
+    std::sort(by_piece.begin(), by_piece.end());
+    by_piece.erase(std::unique(by_piece.begin(), by_piece.end()), by_piece.end());
+    for (std::size_t i = 0; i < by_piece.size();) {
+      std::size_t j = i + 1;
+      while (j < by_piece.size() && by_piece[j].first == by_piece[i].first) ++j;
+      std::int32_t copies = 0;
+      for (const std::int32_t v : g) copies += pieces.find(v) == by_piece[i].first;
+      if (copies > 1) {  // a seam: several file vertices of one piece at one rest position
+        open_ += j - i > 1;
+        file_vertices_ += copies;
+        for (std::size_t k = i; k < j; ++k) nodes_.push_back(by_piece[k].second);
+        starts_.push_back(static_cast<std::int32_t>(nodes_.size()));
+      }
+      i = j;
+    }
   }
 }
 

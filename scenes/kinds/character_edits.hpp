@@ -126,15 +126,21 @@ class TearRun {
 nlohmann::json apply_drill(bullet::SkinnedSoftBody& body, const BindPose& bind,
                            const DrillEdit& edit);
 
-/// The seams of the file: rest positions shared by several of its vertices, and the body's
-/// vertices that stand for them (one when the weld joined them). The gap at a seam is the
-/// largest distance between those vertices now; welded seams stay at zero by construction,
-/// seams left open (weights that differ, separate meshes, no weld) can open.
+/// The seams of the file: rest positions shared by several of its vertices within one
+/// connected piece of skin, and the body's vertices that stand for them (one when the weld
+/// joined them). The gap at a seam is the largest distance between those vertices now; welded
+/// seams stay at zero by construction, seams left open (weights that differ, no weld) can open.
+/// One piece of skin: file vertices joined by faces, by a shared rest position within one mesh
+/// of the file (the importer splits a surface's vertices where their normals or texture
+/// coordinates differ), or by the weld. Separate objects that touch (two boxes sharing a corner,
+/// each on its own mesh and bone) are not seams.
 class SeamGap {
  public:
-  /// `file_rest`: the rest positions as the file gives them (before welding); `vertex_map`:
-  /// file vertex → body vertex (the weld's; identity when empty).
-  SeamGap(const Eigen::Matrix3Xd& file_rest, std::span<const std::int32_t> vertex_map);
+  /// `file_rest`, `file_faces`: the mesh as the file gives it (before welding); `mesh_of`: the
+  /// file mesh of each vertex; `vertex_map`: file vertex → body vertex (the weld's; identity
+  /// when empty).
+  SeamGap(const Eigen::Matrix3Xd& file_rest, std::span<const mesh::Face> file_faces,
+          std::span<const std::int32_t> mesh_of, std::span<const std::int32_t> vertex_map);
   /// The largest gap now (vertices that left Bullet, e.g. drilled out, aside), in the
   /// body's units (metres in the character scene).
   double measure(const bullet::SkinnedSoftBody& body) const;
@@ -142,11 +148,13 @@ class SeamGap {
   std::int32_t file_vertices() const { return file_vertices_; }
   /// Seam positions still held by more than one body vertex.
   std::int32_t open_positions() const { return open_; }
+  /// Rest positions shared by separate pieces of skin (not measured as seams).
+  std::int32_t touching_positions() const { return touching_; }
 
  private:
-  std::vector<std::int32_t> nodes_;   // body vertices, grouped by seam position
+  std::vector<std::int32_t> nodes_;   // body vertices, grouped by seam position and piece
   std::vector<std::int32_t> starts_;  // group g is nodes_[starts_[g], starts_[g + 1])
-  std::int32_t open_ = 0, file_vertices_ = 0;
+  std::int32_t open_ = 0, file_vertices_ = 0, touching_ = 0;
 };
 
 }  // namespace conform::scenes

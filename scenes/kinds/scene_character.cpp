@@ -59,6 +59,16 @@ FirstStep first_step(const bullet::SkinnedSoftBody& body,
   return f;
 }
 
+// The mesh instance (index in model.meshes: a mesh placed twice is two objects) each vertex of
+// the imported model came from.
+std::vector<std::int32_t> file_mesh_of_vertices(const io::SkinnedModel& model) {
+  std::vector<std::int32_t> mesh_of(static_cast<std::size_t>(model.mesh.vertex_count()), -1);
+  for (std::size_t i = 0; i < model.meshes.size(); ++i)
+    std::fill_n(mesh_of.begin() + model.meshes[i].first_vertex, model.meshes[i].vertex_count,
+                std::int32_t(i));
+  return mesh_of;
+}
+
 // What the run carries from step to step.
 struct RunState {
   double worst_offset = 0, mean_offset_sum = 0, worst_seam_gap = 0;
@@ -122,6 +132,8 @@ class Character final : public Scene {
     // length reported are in metres whatever the file's units.
     to_scene_frame(model, frame_of(model));
     const Eigen::Matrix3Xd file_rest = model.mesh.rest;
+    const std::vector<mesh::Face> file_faces = model.mesh.faces;
+    const std::vector<std::int32_t> mesh_of = file_mesh_of_vertices(model);
     const mesh::WeldResult weld =
         weld_ ? io::weld_model(model, import_.weld_options) : mesh::WeldResult{};
     for (const auto& w : model.warnings)
@@ -138,7 +150,7 @@ class Character final : public Scene {
     // snap does it now, so that frame 0 and the start targets below are of that pose.
     body.snap_to_pose();
     const BindPose bind(model.mesh);
-    const SeamGap seams(file_rest, weld.vertex_map);
+    const SeamGap seams(file_rest, file_faces, mesh_of, weld.vertex_map);
     TearRun tear(tear_, bind);
     std::vector<Eigen::Vector3d> start_targets(static_cast<std::size_t>(body.vertex_count()));
     for (std::int32_t v = 0; v < body.vertex_count(); ++v)
@@ -284,6 +296,7 @@ class Character final : public Scene {
                 {"file_vertices_at_seams", seams.file_vertices()},
                 {"positions", seams.positions()},
                 {"open_positions", seams.open_positions()},
+                {"touching_positions", seams.touching_positions()},
                 {"merged_vertices", weld.merged},
                 {"mean_weight_positions", std::int64_t(weld.averaged.size())},
                 {"kept_apart_vertices", weld.kept_apart},
