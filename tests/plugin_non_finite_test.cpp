@@ -121,6 +121,35 @@ TEST_F(TwoArms, AnInfiniteVelocityIsCaughtInTheNextSubstep) {
   EXPECT_FALSE(e.node().value.allFinite());
 }
 
+TEST_F(TwoArms, ARunawayNodeStopsTheStepBeforeItOverflows) {
+  // A finite but unphysical velocity (an unstable integration grows like this for many steps
+  // before it overflows): above Material::max_speed (100 m/s by default) it stops the step.
+  const std::int32_t v = vertex_where(*first, false);
+  first->body_of(v)->m_nodes[first->node_of(v)].m_v.setX(btScalar(1e4));
+  const bullet::NonFiniteState e = step_until_thrown(w, 1);
+  EXPECT_EQ(e.node().vertex, v);
+  EXPECT_TRUE(e.node().runaway);
+  EXPECT_TRUE(e.node().value.allFinite());
+  const std::string what = e.what();
+  EXPECT_NE(what.find("ran away"), std::string::npos) << what;
+  EXPECT_NE(what.find("moves at 10000 m/s"), std::string::npos) << what;
+}
+
+TEST(PluginNonFinite, TheSpeedBoundIsTheMaterialsAndInfinityTurnsItOff) {
+  SoftWorld w;
+  bullet::Plugin plugin{w.world};
+  const mesh::Arm arm = mesh::make_arm(1);
+  bullet::Material links{.model = bullet::MaterialModel::bullet_links};
+  links.max_speed = std::numeric_limits<double>::infinity();
+  bullet::SkinnedSoftBody& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, links);
+  w.step(1);
+  const std::int32_t v = vertex_where(body, false);
+  body.body_of(v)->m_nodes[body.node_of(v)].m_v.setX(btScalar(1e4));
+  EXPECT_NO_THROW(w.step(1));
+  links.max_speed = 0;
+  EXPECT_THROW(plugin.add_skinned_body(arm.mesh, arm.skeleton, links), std::invalid_argument);
+}
+
 TEST_F(TwoArms, AfterTheThrowThePluginStillEditsAndTearsDown) {
   const std::int32_t v = vertex_where(*first, false);
   first->body_of(v)->m_nodes[first->node_of(v)].m_x.setX(btScalar(kNaN));

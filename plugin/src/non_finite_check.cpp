@@ -18,17 +18,22 @@ bool finite(const btVector3& v) {
 }  // namespace
 
 std::optional<NonFiniteNode> SkinnedSoftBody::Impl::first_non_finite_node() const {
+  const double max_speed2 = material_.max_speed * material_.max_speed;  // inf: no bound
   for (std::size_t slot = 0; slot < pieces_.size(); ++slot) {
     const Piece* piece = pieces_[slot].get();
     if (!piece || !piece->body) continue;
     const btSoftBody& body = *piece->body;
     for (int i = 0; i < body.m_nodes.size(); ++i) {
       const btSoftBody::Node& n = body.m_nodes[i];
-      const bool x = finite(n.m_x);
-      if (x && finite(n.m_v)) continue;
+      const bool x = finite(n.m_x), v = finite(n.m_v);
+      const bool runaway = x && v && double(n.m_v.length2()) > max_speed2;
+      if (x && v && !runaway) continue;
       const btVector3& bad = x ? n.m_v : n.m_x;
-      return NonFiniteNode{static_cast<std::int32_t>(slot), i,
-                           piece->node_vertex[static_cast<std::size_t>(i)], !x,
+      return NonFiniteNode{static_cast<std::int32_t>(slot),
+                           i,
+                           piece->node_vertex[static_cast<std::size_t>(i)],
+                           !x,
+                           runaway,
                            Eigen::Vector3d(double(bad.x()), double(bad.y()), double(bad.z()))};
     }
   }
@@ -39,6 +44,14 @@ namespace {
 
 std::string describe(long long substep, double time, std::size_t body, const NonFiniteNode& n) {
   std::ostringstream s;
+  if (n.runaway) {
+    s << "the simulation ran away at substep " << substep << " (t = " << time
+      << " s): skinned body " << body << ", piece " << n.piece << ", node " << n.node
+      << " (mesh vertex " << n.vertex << ") moves at " << n.value.norm()
+      << " m/s, faster than its Material::max_speed, at the start of that substep; too large a "
+         "time step, force or stiffness for the material?";
+    return s.str();
+  }
   s << "the simulation went non-finite at substep " << substep << " (t = " << time
     << " s): skinned body " << body << ", piece " << n.piece << ", node " << n.node
     << " (mesh vertex " << n.vertex << ") has " << (n.position ? "position" : "velocity") << " ("

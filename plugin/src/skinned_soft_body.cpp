@@ -92,6 +92,8 @@ void validate(const Material& material) {
           "bending_stiffness", material.bending_stiffness, "[0, 1]");
   require(finite(material.margin) && material.margin >= 0 && material.margin <= 1, "margin",
           material.margin, "[0, 1] m");
+  require(!std::isnan(material.max_speed) && material.max_speed > 0, "max_speed",
+          material.max_speed, "> 0 m/s (infinity: no bound)");
   if (material.model == MaterialModel::membrane) {
     material.skin.validate();  // throws naming the field and its value
     material.solver.validate();

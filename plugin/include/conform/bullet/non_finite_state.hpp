@@ -5,7 +5,8 @@
 // The pass sees what happened since the previous one: the previous substep's drive and
 // Bullet's solve, and this substep's motion prediction (so the drive never reads a NaN). What
 // the last substep of a stepSimulation leaves is seen at the start of the next one;
-// SkinnedSoftBody::first_non_finite_node() asks at any time.
+// SkinnedSoftBody::first_non_finite_node() asks at any time. The same pass stops a runaway: a
+// node faster than the body's Material::max_speed (its velocity finite but unphysical).
 // The exception leaves stepSimulation mid-step; the world's state is then only fit for
 // inspection and teardown.
 #pragma once
@@ -25,6 +26,7 @@ struct NonFiniteNode {
   int node = -1;             // the node's index in the piece's btSoftBody
   std::int32_t vertex = -1;  // the mesh vertex it mirrors
   bool position = true;      // position (m_x) non-finite, else velocity (m_v)
+  bool runaway = false;      // the velocity is finite but faster than Material::max_speed
   Eigen::Vector3d value = Eigen::Vector3d::Zero();
 };
 

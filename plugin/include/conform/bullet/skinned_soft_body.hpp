@@ -113,6 +113,11 @@ struct Material {
   double bending_stiffness = 0.0;
   /// Collision margin of the pieces, m.
   double margin = 0.005;
+  /// A node faster than this, m/s, is a runaway: the plugin stops the step with
+  /// bullet::NonFiniteState naming it, as it does for a NaN (an unstable integration often
+  /// grows for many steps before it overflows, writing finite garbage). > 0; infinity turns the
+  /// check off. The default, 100 m/s, is far above any motion of a body's skin.
+  double max_speed = 100.0;
   /// membrane: the skin's material (SI units, sourced defaults for human skin).
   membrane::SkinMaterial skin{};
   /// membrane: the solve of each substep (tolerance in Pa of nodal traction).
