@@ -8,6 +8,7 @@
 #include "body.hpp"
 #include "conform/io/import.hpp"
 #include "conform/skin/procedural_arm.hpp"
+#include "kinds/model_frame.hpp"
 
 namespace conform::python {
 
@@ -57,8 +58,25 @@ Body add_arm(const py::object& self, const bullet::Material& material, int resol
   return make_body(self, w.plugin->add_skinned_body(arm.mesh, arm.skeleton, material));
 }
 
-Body add_model(const py::object& self, const std::string& file, const bullet::Material& material) {
+// File units per metre: the given number, else (None) the unit the file states (FBX's
+// UnitScaleFactor, in cm), else 100, as the character scene reads model.units_per_metre =
+// "file"; the procedural arm ("arm", "arm:N") is in metres already.
+double units_per_metre(const io::SkinnedModel& model, const std::string& file,
+                       const std::optional<double>& given) {
+  if (given) {
+    if (!(*given >= 1e-6 && *given <= 1e6))
+      throw std::invalid_argument("units_per_metre = " + std::to_string(*given) +
+                                  " is out of range [1e-06, 1e+06]");
+    return *given;
+  }
+  if (file.rfind("arm", 0) == 0 && model.source.rfind("arm", 0) == 0) return 1;
+  return model.unit_scale_cm > 0 ? 100 / model.unit_scale_cm : 100;
+}
+
+Body add_model(const py::object& self, const std::string& file, const bullet::Material& material,
+               const std::optional<double>& units, const std::string& up) {
   io::SkinnedModel model = io::load_model(file);
+  scenes::to_scene_frame(model, {units_per_metre(model, file, units), up});
   World& w = self.cast<World&>();
   Body b = make_body(self, w.plugin->add_skinned_body(model, material));
   b.animations = std::move(model.animations);
@@ -79,8 +97,11 @@ void bind_world(py::module_& m) {
            "Adds the procedural arm (shoulder at the origin, along +z; bones shoulder, elbow, "
            "wrist) as a skinned soft body.")
       .def("add_model", &add_model, py::arg("file"), py::arg("material") = bullet::Material{},
-           "Adds a rigged model file (assimp; 'arm' or 'arm:N' for the procedural arm) in the "
-           "file's own units and axes. Raises ModelImportError.")
+           py::arg("units_per_metre") = py::none(), py::arg("up") = "y",
+           "Adds a rigged model file (assimp; 'arm' or 'arm:N' for the procedural arm), brought "
+           "to metres and Y up as the character scene does: units_per_metre file units make a "
+           "metre (None: the unit the file states, else 100), up ('y' or 'z') is the file's up "
+           "axis. Raises ModelImportError for a file that cannot be read.")
       .def("step", &step, py::arg("dt") = 1.0 / 60, py::arg("substeps") = 1,
            "Advances dt seconds in `substeps` equal substeps. Raises NonFiniteState when the "
            "simulation goes non-finite.")
