@@ -16,6 +16,9 @@ packages=(
   ffmpeg          # conform run's video of the pictures (run.gif / run.mp4)
   libtinygltf-dev # conform run's run.glb (glTF 2.0 binary)
   clang-14 libclang-rt-14-dev  # scripts/fuzz.sh: libFuzzer targets (CI's bounded fuzz run)
+  pybind11-dev python3-dev  # the Python module conform (python/), for Debian's /usr/bin/python3
+  python3-numpy python3-pytest  # its arrays and its test suite (ctest python_test)
+  python3-matplotlib  # examples/python: the plots
 )
 
 missing=()
