@@ -250,34 +250,24 @@ void gradient_all(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
 }
 
 // The initial guess, with the gradient and residuals at it (Phase 3): x, or the alternative
-// where its Phi is lower (free nodes only), each guess's elements evaluated once. The
-// alternative comes first and is taken as it is when already in balance: a body at rest, whose
-// alternative is the last solution carried with its targets, then costs one pass that reuses
-// every element and skips the prediction's (which would only be compared and dropped).
+// where its Phi is lower (free nodes only), each guess's elements evaluated once. Both are
+// always compared: a guess within the tolerance is no reason to skip the other, whose lower Phi
+// may carry momentum or gravity (a free sheet's fall) below the tolerance's force.
 void choose_guess(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
   Solver::Scratch& s = c.s;
-  if (c.in.alternative_guess.cols() != c.nv || !c.in.alternative_guess.allFinite()) {
-    evaluate_elements(c, x, s.forces_);
-    gradient_all(c, x);
-    return;
-  }
-  Eigen::Matrix3Xd& other = s.trial_;
-  other = x;
-  for (std::int64_t v = 0; v < c.nv; ++v)
-    if (s.free_[std::size_t(v)]) other.col(v) = c.in.alternative_guess.col(v);
-  evaluate_elements(c, other, s.forces_);
-  gradient_all(c, other);
-  const bool balanced = c.settings.take_balanced_guess &&
-                        (c.nv == 0 || s.node_residual_.maxCoeff() <= c.tolerance);
-  if (!balanced) {
-    evaluate_elements(c, x, s.guess_forces_);
-    if (!(total_potential(c, other, s.forces_) < total_potential(c, x, s.guess_forces_))) {
+  evaluate_elements(c, x, s.forces_);
+  if (c.in.alternative_guess.cols() == c.nv && c.in.alternative_guess.allFinite()) {
+    Eigen::Matrix3Xd& other = s.trial_;
+    other = x;
+    for (std::int64_t v = 0; v < c.nv; ++v)
+      if (s.free_[std::size_t(v)]) other.col(v) = c.in.alternative_guess.col(v);
+    evaluate_elements(c, other, s.guess_forces_);
+    if (total_potential(c, other, s.guess_forces_) < total_potential(c, x, s.forces_)) {
+      x = other;
       std::swap(s.forces_, s.guess_forces_);
-      gradient_all(c, x);
-      return;
     }
   }
-  x = other;
+  gradient_all(c, x);
 }
 
 // Phase 4: the nodes this Newton step moves. Right after an edit the imbalance is large and

@@ -70,11 +70,6 @@ struct SolverSettings {
   /// ... where near is within local_reach decay lengths sqrt(E t / k_t) of the attachment
   /// (the distance over which it screens a load: about 4 cm for the default skin), > 0.
   double local_reach = 2;
-  /// Take the alternative guess (StepInput::alternative_guess) as it is when it is already
-  /// within the tolerance, without evaluating x's elements: a body at rest then costs one pass
-  /// that reuses every element. false compares the two guesses' Phi always (the solver's
-  /// behaviour before; the benchmarks' baseline).
-  bool take_balanced_guess = true;
   /// Solve each symmetric_gauss_seidel system on a packed copy of its active rows (contiguous
   /// memory, the same step bit for bit). false: in place over the whole mesh's arrays (the
   /// solver before; the benchmarks' baseline).
