@@ -7,6 +7,8 @@
 #include <sstream>
 
 #include <stdexcept>
+
+#include "active_system.hpp"
 #include "range_error.hpp"
 
 namespace conform::membrane {
@@ -72,6 +74,8 @@ struct Solver::Scratch {
   std::vector<std::int32_t> reached_, seed_of_;  // the active set's search (select_active)
   Eigen::Matrix3Xd predicted_, gradient_, step_, r_, z_, p_, q_, trial_, trial_direction_;
   Eigen::VectorXd inertia_weight_, node_residual_;
+  ActiveSystem system_;  // the Newton system of the active nodes, packed
+  Eigen::Matrix3Xd packed_rhs_, packed_step_;
 };
 
 Solver::Solver() : scratch_(std::make_unique<Scratch>()) {}
@@ -192,23 +196,6 @@ double total_potential(const Context& c, const Eigen::Ref<const Eigen::Matrix3Xd
   return total;
 }
 
-// The initial guess: x (whose elements' forces_ are evaluated), or the alternative where its
-// Phi is lower (free nodes only). Each guess's elements are evaluated once, and the winner's
-// forces are kept for the first gradient: one pass over the elements per guess.
-void choose_guess(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
-  if (c.in.alternative_guess.cols() != c.nv || !c.in.alternative_guess.allFinite()) return;
-  Solver::Scratch& s = c.s;
-  Eigen::Matrix3Xd& other = s.trial_;
-  other = x;
-  for (std::int64_t v = 0; v < c.nv; ++v)
-    if (s.free_[std::size_t(v)]) other.col(v) = c.in.alternative_guess.col(v);
-  evaluate_elements(c, other, s.guess_forces_);
-  if (total_potential(c, other, s.guess_forces_) < total_potential(c, x, s.forces_)) {
-    x = other;
-    std::swap(s.forces_, s.guess_forces_);
-  }
-}
-
 // Phase 3: the gradient of Phi, g = sum_e A_e t P_e beta_a + K_i (x_i - T_i) + w_i (x_i - xp_i),
 // 0 at fixed nodes; and each node's residual |g_i| / A_i (Pa). scatter_element adds an element's
 // change of corner forces (ElementForces) f1, f2 to its corners' gradients.
@@ -260,6 +247,27 @@ void gradient_all(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
     }
     node_residual(c, v);
   }
+}
+
+// The initial guess, with the gradient and residuals at it (Phase 3): x, or the alternative
+// where its Phi is lower (free nodes only), each guess's elements evaluated once. Both are
+// always compared: a guess within the tolerance is no reason to skip the other, whose lower Phi
+// may carry momentum or gravity (a free sheet's fall) below the tolerance's force.
+void choose_guess(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
+  Solver::Scratch& s = c.s;
+  evaluate_elements(c, x, s.forces_);
+  if (c.in.alternative_guess.cols() == c.nv && c.in.alternative_guess.allFinite()) {
+    Eigen::Matrix3Xd& other = s.trial_;
+    other = x;
+    for (std::int64_t v = 0; v < c.nv; ++v)
+      if (s.free_[std::size_t(v)]) other.col(v) = c.in.alternative_guess.col(v);
+    evaluate_elements(c, other, s.guess_forces_);
+    if (total_potential(c, other, s.guess_forces_) < total_potential(c, x, s.forces_)) {
+      x = other;
+      std::swap(s.forces_, s.guess_forces_);
+    }
+  }
+  gradient_all(c, x);
 }
 
 // Phase 4: the nodes this Newton step moves. Right after an edit the imbalance is large and
@@ -520,8 +528,28 @@ int gauss_seidel_cg(Context& c) {
   return it;
 }
 
+// gauss_seidel_cg on the packed active system (active_system.hpp): the same step.
+int packed_gauss_seidel_cg(Context& c) {
+  Solver::Scratch& s = c.s;
+  const auto& list = s.active_list_;
+  s.system_.pack({c.model.block_start(), c.model.block_column(), c.model.diagonal_block(),
+                  s.blocks_, s.block_inverse_, list, s.active_});
+  const auto na = static_cast<Eigen::Index>(list.size());
+  s.packed_rhs_.resize(3, na);
+  for (Eigen::Index i = 0; i < na; ++i) s.packed_rhs_.col(i) = -s.gradient_.col(list[std::size_t(i)]);
+  const int it = s.system_.gauss_seidel_cg(s.packed_rhs_, c.settings.cg_relative_tolerance,
+                                           c.settings.max_cg_iterations, s.packed_step_);
+  for (Eigen::Index i = 0; i < na; ++i) s.step_.col(list[std::size_t(i)]) = s.packed_step_.col(i);
+  return it;
+}
+
 int conjugate_gradients(Context& c) {
   Solver::Scratch& s = c.s;
+  if (c.settings.preconditioner == Preconditioner::symmetric_gauss_seidel &&
+      c.settings.packed_systems) {
+    s.step_.resize(3, c.nv);
+    return packed_gauss_seidel_cg(c);
+  }
   for (auto* m : {&s.step_, &s.r_, &s.z_, &s.p_, &s.q_, &s.trial_direction_}) m->resize(3, c.nv);
   return c.settings.preconditioner == Preconditioner::block_jacobi ? jacobi_cg(c)
                                                                    : gauss_seidel_cg(c);
@@ -618,10 +646,8 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
   prepare_nodes(c, x);
   s.free_.resize(std::size_t(nv));
   for (Eigen::Index v = 0; v < nv; ++v) s.free_[std::size_t(v)] = !c.fixed(v);
-  evaluate_elements(c, x, s.forces_);
   choose_guess(c, x);
   s.trial_ = x;
-  gradient_all(c, x);
   SolveReport report;
   for (;; ++report.newton_iterations) {
     report.residual = s.node_residual_.size() ? s.node_residual_.maxCoeff() : 0.0;

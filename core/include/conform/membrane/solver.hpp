@@ -70,6 +70,10 @@ struct SolverSettings {
   /// ... where near is within local_reach decay lengths sqrt(E t / k_t) of the attachment
   /// (the distance over which it screens a load: about 4 cm for the default skin), > 0.
   double local_reach = 2;
+  /// Solve each symmetric_gauss_seidel system on a packed copy of its active rows (contiguous
+  /// memory, the same step bit for bit). false: in place over the whole mesh's arrays (the
+  /// solver before; the benchmarks' baseline).
+  bool packed_systems = true;
   /// OpenMP threads for the element and node loops of large meshes (1: serial). The results do
   /// not depend on it (every sum is gathered per vertex in a fixed order).
   int threads = 1;
