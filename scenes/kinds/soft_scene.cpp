@@ -128,7 +128,8 @@ bullet::Material read_material(Reader& root, const bullet::Material& d) {
   m.kinematic_weight = r.number("kinematic_weight", d.kinematic_weight, 0, 2);
   m.position_iterations = r.integer("position_iterations", d.position_iterations, 1, 200);
   m.margin = r.number("margin", d.margin, 0, 1);
-  m.max_speed = r.number("max_speed", d.max_speed, 1e-6, 1e12);  // m/s: a runaway stops the run
+  // m/s: a runaway stops the run (the library's default, no bound, is for worlds of any unit).
+  m.max_speed = r.number("max_speed", std::isinf(d.max_speed) ? 100.0 : d.max_speed, 1e-6, 1e12);
   r.finish();
   return m;
 }

@@ -42,6 +42,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <span>
@@ -113,11 +114,12 @@ struct Material {
   double bending_stiffness = 0.0;
   /// Collision margin of the pieces, m.
   double margin = 0.005;
-  /// A node faster than this, m/s, is a runaway: the plugin stops the step with
-  /// bullet::NonFiniteState naming it, as it does for a NaN (an unstable integration often
-  /// grows for many steps before it overflows, writing finite garbage). > 0; infinity turns the
-  /// check off. The default, 100 m/s, is far above any motion of a body's skin.
-  double max_speed = 100.0;
+  /// A node faster than this, in the world's length unit per second, is a runaway: the plugin
+  /// stops the step with bullet::NonFiniteState naming it, as it does for a NaN (an unstable
+  /// integration often grows for many steps before it overflows, writing finite garbage). > 0.
+  /// The default, infinity, turns the check off, since the plugin does not know the world's
+  /// unit; the scenes (in metres) set 100 m/s, far above any motion of a body's skin.
+  double max_speed = std::numeric_limits<double>::infinity();
   /// membrane: the skin's material (SI units, sourced defaults for human skin).
   membrane::SkinMaterial skin{};
   /// membrane: the solve of each substep (tolerance in Pa of nodal traction).
