@@ -21,7 +21,8 @@ std::vector<std::int32_t> flagged_vertices(const std::vector<std::uint8_t>& flag
 
 /// A membrane on an elastic foundation of stiffness k (Pa/m), plane stress. A straight
 /// traction-free edge made in a sheet under the pre-stress sigma normal to it retracts by
-///   u(d) = u0 exp(-d / l),  u0 = sigma l / E'',  l = sqrt(E'' t / k),  E'' = E / (1 - nu^2),
+///   u(d) = u0 exp(-d / l),  u0 = sigma l / E'',  l = sqrt(E'' t / k),  E'' = E / (1 - nu^2)
+///   (isotropic),
 /// from E'' t u'' = k u (the strain across a straight edge is uniaxial: eps_yy = 0) with the
 /// edge free, E'' u'(0) = -sigma, and u -> 0 far from it.
 struct Foundation {

@@ -36,7 +36,7 @@ using Clock = std::chrono::steady_clock;
 // The built-in scene `membrane-edge` (`conform scenes --show membrane-edge`).
 constexpr const char* kMembraneEdgeJson = R"json({
   "scene": "membrane-edge",
-  "description": "A square sheet of skin membrane (SI units) on its foundation (attachment_stiffness k), border free, pre-stressed by material.prestress = [sigma_xx, sigma_yy] along its axes, is cut along the plane x = 0 by the plugin's planar cut on the live Bullet soft body; it settles, and each lip's retraction at mid-edge is compared with the membrane on an elastic foundation (plane stress): u(d) = u0 exp(-d / l), u0 = sigma_xx l / E'', l = sqrt(E'' t / k), E'' = E / (1 - nu^2).",
+  "description": "A square sheet of skin membrane (SI units) on its foundation (attachment_stiffness k), border free, pre-stressed by material.prestress = [sigma_xx, sigma_yy] along its axes, is cut along the plane x = 0 by the plugin's planar cut on the live Bullet soft body; it settles, and each lip's retraction at mid-edge is compared with the membrane on an elastic foundation (plane stress): u(d) = u0 exp(-d / l), u0 = sigma_xx l / E'', l = sqrt(E'' t / k), E'' = E / (1 - nu^2) (4 E / 3 for the incompressible neo-Hookean law: the law's modulus of a strain across the edge with none along it).",
   "duration": 0.5,
   "sheet": { "decay_lengths": 20, "resolution": 0.004, "fine_across": 4, "fine_along": 2, "grading": 1.2 },
   "cut": { "at": 0.1 },

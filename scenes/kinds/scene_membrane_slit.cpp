@@ -6,8 +6,9 @@
 // the pre-stress normal to the slit (slit_sheet.hpp). Reports w_max, the profile's R^2 against the
 // ellipse, the LEFM value and the membrane solver's residual. With a foundation
 // (material.attachment_stiffness k > 0) and a slit much longer than its decay length
-// l = sqrt(E'' t / k), E'' = E / (1 - nu^2), the opening tends to 2 sigma_n l / E'' instead
-// (metrics.foundation_w_max; absent when k = 0: a summary holds finite numbers only).
+// l = sqrt(E'' t / k), E'' = E / (1 - nu^2) (4 E / 3 neo-Hookean), the opening tends to
+// 2 sigma_n l / E'' instead (metrics.foundation_w_max; absent when k = 0: a summary holds finite
+// numbers only).
 //
 // The run must reach the static equilibrium: each step stops as soon as its residual is below
 // the tolerance, so a state whose out-of-balance force per node area is below it stays put. On
