@@ -584,6 +584,15 @@ class TearAdvance {
       }
     }
     if (smooth) flip_beside_path();
+    // Every split ends here: a path through a vertex on a border (a boundary, a hole's rim)
+    // would leave that vertex joined across the opened path, a pinch (two fans at one vertex),
+    // whichever split made it.
+    for (std::size_t i = 0; i + 1 < path_.size(); ++i)
+      if (path_[i].out.kind == PathPoint::Vertex &&
+          on_border(path_[i].face, corner_of(path_[i].face, path_[i].out.v))) {
+        tear_.message_ = "the path crosses a vertex on a border; the tear stops before it";
+        return false;
+      }
     std::sort(split_.removed_faces.begin(), split_.removed_faces.end());
     split_.removed_faces.erase(
         std::unique(split_.removed_faces.begin(), split_.removed_faces.end()),
