@@ -559,6 +559,10 @@ class TearAdvance {
   // Step 3, first change: split the crossed faces along S_i, Q_1 … Q_m, S_i+1. False (and
   // the mesh unchanged) when the new tip would be in a face too thin for it.
   bool split_along_path() {
+    if (path_through_border_vertex()) {
+      tear_.message_ = "the path crosses a vertex on a border; the tear stops before it";
+      return false;
+    }
     split_.base_vertex_count = nv0_ = mesh_.vertex_count();
     split_.base_face_count = mesh_.face_count();
     const bool smooth = tear_.options_.smooth_lips;
@@ -584,15 +588,6 @@ class TearAdvance {
       }
     }
     if (smooth) flip_beside_path();
-    // Every split ends here: a path through a vertex on a border (a boundary, a hole's rim)
-    // would leave that vertex joined across the opened path, a pinch (two fans at one vertex),
-    // whichever split made it.
-    for (std::size_t i = 0; i + 1 < path_.size(); ++i)
-      if (path_[i].out.kind == PathPoint::Vertex &&
-          on_border(path_[i].face, corner_of(path_[i].face, path_[i].out.v))) {
-        tear_.message_ = "the path crosses a vertex on a border; the tear stops before it";
-        return false;
-      }
     std::sort(split_.removed_faces.begin(), split_.removed_faces.end());
     split_.removed_faces.erase(
         std::unique(split_.removed_faces.begin(), split_.removed_faces.end()),
@@ -714,9 +709,6 @@ class TearAdvance {
     // the crossing splits: a tip joined to that border would pinch it.
     for (int k = 0; k < 3; ++k)
       if (f[k] != tear_.tip_ && on_border(face, k)) return false;
-    for (const Crossing& c : path_)
-      if (c.out.kind == PathPoint::Vertex && on_border(c.face, corner_of(c.face, c.out.v)))
-        return false;
     std::array<double, 3> raw{};
     if (!blade_barycentrics(f, kExactMargin, raw)) return false;
     const Eigen::Vector3d pa = mesh_.current.col(f[0]), pb = mesh_.current.col(f[1]),
@@ -761,6 +753,16 @@ class TearAdvance {
     target_ = hit;
     off_track_ = lambda > 0;
     return true;
+  }
+
+  // The path goes through a vertex on a border (a boundary, a hole's rim, the tear's own lips):
+  // whichever split made it, that vertex would stay joined across the opened path, a pinch (two
+  // fans at one vertex). The walks stop at such a vertex; a path may still reach one.
+  bool path_through_border_vertex() const {
+    for (const Crossing& c : path_)
+      if (c.out.kind == PathPoint::Vertex && on_border(c.face, corner_of(c.face, c.out.v)))
+        return true;
+    return false;
   }
 
   // Corner k of `face` is on a border of the mesh (the tear's slit or a boundary): a face
