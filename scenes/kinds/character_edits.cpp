@@ -277,23 +277,22 @@ SeamGap::SeamGap(const Eigen::Matrix3Xd& rest, std::span<const mesh::Face> faces
       if (mesh_of[std::size_t(g[k])] == mesh_of[std::size_t(g[0])]) pieces.join(g[0], g[k]);
   starts_.push_back(0);
   for (const auto& g : groups) {
-    std::vector<std::int32_t> group_pieces;
-    for (const std::int32_t v : g) group_pieces.push_back(pieces.find(v));
-    std::sort(group_pieces.begin(), group_pieces.end());
-    touching_ += std::unique(group_pieces.begin(), group_pieces.end()) - group_pieces.begin() > 1;
-    std::vector<std::pair<std::int32_t, std::int32_t>> by_piece;  // (piece, body vertex)
-    for (const std::int32_t v : g) by_piece.emplace_back(pieces.find(v), node(v));
-    std::sort(by_piece.begin(), by_piece.end());
-    by_piece.erase(std::unique(by_piece.begin(), by_piece.end()), by_piece.end());
-    for (std::size_t i = 0; i < by_piece.size();) {
+    // One entry per file vertex, (piece, body vertex), sorted: a run of one piece is that
+    // piece's copies of the position.
+    std::vector<std::pair<std::int32_t, std::int32_t>> copies;
+    for (const std::int32_t v : g) copies.emplace_back(pieces.find(v), node(v));
+    std::sort(copies.begin(), copies.end());
+    touching_ += copies.front().first != copies.back().first;
+    for (std::size_t i = 0; i < copies.size();) {
       std::size_t j = i + 1;
-      while (j < by_piece.size() && by_piece[j].first == by_piece[i].first) ++j;
-      std::int32_t copies = 0;
-      for (const std::int32_t v : g) copies += pieces.find(v) == by_piece[i].first;
-      if (copies > 1) {  // a seam: several file vertices of one piece at one rest position
-        open_ += j - i > 1;
-        file_vertices_ += copies;
-        for (std::size_t k = i; k < j; ++k) nodes_.push_back(by_piece[k].second);
+      while (j < copies.size() && copies[j].first == copies[i].first) ++j;
+      if (j - i > 1) {  // a seam: several file vertices of one piece at one rest position
+        const std::size_t first = nodes_.size();
+        for (std::size_t k = i; k < j; ++k)
+          if (k == i || copies[k].second != copies[k - 1].second)
+            nodes_.push_back(copies[k].second);
+        open_ += nodes_.size() - first > 1;
+        file_vertices_ += static_cast<std::int32_t>(j - i);
         starts_.push_back(static_cast<std::int32_t>(nodes_.size()));
       }
       i = j;
