@@ -236,15 +236,18 @@ struct PictureRenderer::Pending {
   StripCamera strip{};
   fs::path pics;
   std::vector<fs::path> inputs;                                // the PLY files render.sh reads
-  std::vector<std::pair<PrestartedRender*, std::string>> fed;  // and the render each makes
+  std::vector<std::pair<PrestartedRender*, std::size_t>> fed;  // and the input it took
+  std::vector<Input> fed_inputs;  // kept to render anew if the early f3d fails
   std::size_t panels = 0;
   // The f3d renders run from here, at most `cores` at once (f3d is single-threaded and spends
   // most of its time starting), started by this thread (their parent-death signal follows it).
   std::vector<std::vector<std::string>> jobs;  // arguments, in pictures/
   std::vector<std::string> job_names;          // the render each makes
+  std::vector<bool> retry;                     // whether a failed job is rendered again
   std::size_t next_job = 0;
   std::deque<ChildProcess> running;
-  std::string display;  // ":N" when conform has no display of its own
+  std::deque<std::size_t> running_jobs;  // the job each runs
+  std::string display;                   // ":N" when conform has no display of its own
   std::size_t cores = 1;
 };
 
@@ -269,7 +272,33 @@ void PictureRenderer::launch_renders(Pending& p) {
     options.log = fs::absolute(p.pics / (p.job_names[k] + ".png.log")).string();
     options.dir = fs::absolute(p.pics).string();
     p.running.emplace_back(p.jobs[k], options);
+    p.running_jobs.push_back(k);
   }
+}
+
+// A render of `in` by a new f3d, from its PLY file; a job that fails is rendered once more
+// when `retry` (f3d under Xvfb now and then exits without a picture on a loaded machine).
+void PictureRenderer::queue_render(Pending& p, const Input& in, bool retry) const {
+  const fs::path ply = p.pics / (in.name + ".ply");
+  std::ofstream(ply, std::ios::binary) << in.ply;
+  p.inputs.push_back(ply);
+  p.jobs.push_back(
+      f3d_arguments(in.name + ".ply", in.name + ".png", in.width, settings_.height, in.view_angle));
+  p.job_names.push_back(in.name);
+  p.retry.push_back(retry);
+}
+
+// After job `k` ended with `status`: whether it made its picture; if not, and it may, it is
+// queued again (the same arguments, noted in the report).
+bool PictureRenderer::job_done(Pending& p, std::size_t k, int status) {
+  if (status == 0 && fs::exists(p.pics / (p.job_names[k] + ".png"))) return true;
+  if (!p.retry[k]) return false;
+  p.report["notes"].push_back("the f3d render of " + p.job_names[k] + " failed (exit " +
+                              std::to_string(status) + "): rendered again");
+  p.jobs.push_back(p.jobs[k]);
+  p.job_names.push_back(p.job_names[k]);
+  p.retry.push_back(false);
+  return false;
 }
 
 // Every render's surface: one strip per frame (strip_camera), or one per panel through the
@@ -330,12 +359,7 @@ void PictureRenderer::start() {
       comments.push_back(shell_words(prestarted_[last - 1]->arguments()));
       continue;
     }
-    const fs::path ply = p.pics / (in.name + ".ply");
-    std::ofstream(ply, std::ios::binary) << in.ply;
-    p.inputs.push_back(ply);
-    p.jobs.push_back(f3d_arguments(in.name + ".ply", in.name + ".png", in.width, settings_.height,
-                                   in.view_angle));
-    p.job_names.push_back(in.name);
+    queue_render(p, in, true);
   }
   if (!write_render_record(p.pics, p.jobs, p.job_names, comments))
     fail(p.report, "cannot write " + (p.pics / "render.sh").string());
@@ -357,7 +381,8 @@ bool PictureRenderer::feed_prestarted(std::size_t k, const Input& in, Pending& p
                                 " could not take its surface (" + problem + "): rendered anew");
     return false;
   }
-  p.fed.emplace_back(&r, in.name);
+  p.fed.emplace_back(&r, p.fed_inputs.size());
+  p.fed_inputs.push_back(in);
   return true;
 }
 
@@ -369,21 +394,28 @@ Json PictureRenderer::finish() {
   if (p.jobs.empty() && p.fed.empty()) return report;
   Progress bar("pictures", "render", long(jobs_count(p.frames, settings_.perspective)));
   long rendered = 0;
-  for (const auto& [render, name] : p.fed) {
+  for (const auto& [render, k] : p.fed) {
     std::string problem;
     const bool ok = render->finish(problem);
     check_interrupt();
-    if (ok)
-      fs::rename(render->png(), p.pics / (name + ".png"));
-    else
-      warn(report, problem);  // why: its render is missing, a failure below
-    bar.update(++rendered);
+    const Input& in = p.fed_inputs[k];
+    if (ok) {
+      fs::rename(render->png(), p.pics / (in.name + ".png"));
+      bar.update(++rendered);
+      continue;
+    }
+    report["notes"].push_back("the f3d started early for " + in.name + " failed (" + problem +
+                              "): rendered anew");
+    queue_render(p, in, true);
   }
+  launch_renders(p);
   while (!p.running.empty()) {
     const int status = p.running.front().wait();
     check_interrupt();
+    const std::size_t k = p.running_jobs.front();
     p.running.pop_front();
-    if (status == 0) bar.update(++rendered);
+    p.running_jobs.pop_front();
+    if (job_done(p, k, status)) bar.update(++rendered);
     launch_renders(p);
   }
   bar.finish();

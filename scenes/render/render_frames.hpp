@@ -59,6 +59,8 @@ class PictureRenderer {
   struct Input;    // one render's surface
   std::vector<Input> inputs(const Pending& p) const;
   bool feed_prestarted(std::size_t k, const Input& in, Pending& p);
+  void queue_render(Pending& p, const Input& in, bool retry) const;
+  static bool job_done(Pending& p, std::size_t k, int status);
   static void launch_renders(Pending& p);
 
   RenderSettings settings_;
