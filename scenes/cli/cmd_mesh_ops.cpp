@@ -29,6 +29,7 @@
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/tear.hpp"
+#include "kinds/provenance.hpp"
 
 namespace conform::cli {
 
@@ -105,6 +106,7 @@ std::vector<fs::path> inputs(const Common& c) {
 mesh::SkinnedMesh load(const Common& c, nlohmann::json& summary) {
   scenes::check_output_folder(c.out, inputs(c));  // refused before the long work
   const auto t0 = Clock::now();
+  summary["provenance"] = scenes::provenance(std::chrono::system_clock::now());
   io::ImportOptions options;
   options.strict_weights = c.strict_weights;
   options.isolate = true;  // a corrupt file must not kill or corrupt the command

@@ -15,6 +15,7 @@
 #include "conform/io/mesh_export.hpp"
 #include "conform/version.hpp"
 #include "kinds/output_caps.hpp"
+#include "kinds/provenance.hpp"
 #include "render/gltf_sequence.hpp"
 #include "render/render_frames.hpp"
 
@@ -80,7 +81,11 @@ void RunOutput::Csv::row(std::span<const double> values) {
 }
 
 RunOutput::RunOutput(fs::path dir, const CommonSettings& common)
-    : dir_(std::move(dir)), common_(common), start_(Clock::now()), cpu_start_(std::clock()) {
+    : dir_(std::move(dir)),
+      common_(common),
+      start_(Clock::now()),
+      started_at_(std::chrono::system_clock::now()),
+      cpu_start_(std::clock()) {
   std::error_code ec;
   fs::create_directories(dir_ / "frames", ec);
   if (ec)
@@ -276,6 +281,7 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   summary["version"] = conform::version();
   summary["bullet_precision"] = bullet::bullet_precision();
   summary["seed"] = common_.seed;
+  summary["provenance"] = provenance(started_at_);
   summary["settings"] = settings;
   // The per-second and per-step figures are of the stepping loop (physics, skinning, topology,
   // metrics, frames); wall_s also counts loading, setup and plotting.

@@ -127,6 +127,7 @@ class RunOutput {
   std::filesystem::path dir_;
   CommonSettings common_;
   Clock::time_point start_;
+  std::chrono::system_clock::time_point started_at_;  // for the summary's provenance
   std::clock_t cpu_start_;
   std::unique_ptr<Csv> metrics_;
   std::vector<Plot> plots_;
