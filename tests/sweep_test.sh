@@ -63,6 +63,11 @@ done
 [[ $(grep -c "^     'data/\|^plot 'data/" "$tmp/grid/plots/rms_error_vs_physics_substeps.gp") -eq 2 ]] ||
   fail "rms_error vs substeps should have 2 lines (one per arm.kp)"
 grep -q 'arm.kp = 0.3' "$tmp/grid/plots/rms_error_vs_physics_substeps.gp" || fail "no legend per line"
+# A key of whole numbers gets a tic at each value (not 1.5 between 1 and 2); a key of fractions
+# gnuplot's own tics.
+grep -q '^set xtics (1, 2, 4)$' "$tmp/grid/plots/rms_error_vs_physics_substeps.gp" ||
+  fail "substeps 1, 2, 4 should be the only x tics"
+grep -q '^set xtics autofreq$' "$tmp/grid/plots/rms_error_vs_arm_kp.gp" || fail "arm.kp: gnuplot's tics"
 
 # --- a rerun skips finished points ------------------------------------------------------------
 stamp="$(stat -c %i-%Y "$tmp/grid/runs/00003/summary.json")"

@@ -73,8 +73,12 @@ void RunOutput::Csv::row(std::span<const double> values) {
                            std::to_string(columns_.size()));
   char buf[32];
   for (std::size_t i = 0; i < values.size(); ++i) {
-    // %.9g keeps the file deterministic and exact enough to compare runs.
-    std::snprintf(buf, sizeof buf, "%.9g", values[i]);
+    // %.9g keeps the file deterministic and exact enough to compare runs; kAbsent (NaN) is an
+    // empty field, which gnuplot, numpy's genfromtxt and pandas read as missing.
+    if (std::isnan(values[i]))
+      buf[0] = '\0';
+    else
+      std::snprintf(buf, sizeof buf, "%.9g", values[i]);
     out_ << (i ? "," : "") << buf;
   }
   out_ << "\n";
@@ -158,90 +162,33 @@ void RunOutput::progress(int step, int steps) {
   progress_->update(step);
 }
 
-namespace {
-
-// A gnuplot string constant holding `s` as it is: single-quoted, where gnuplot substitutes no
-// backquoted command and no escape (a quote is doubled). A line break would end the command:
-// it becomes a space.
-std::string quote(const std::string& s) {
-  std::string out = "'";
-  for (const char c : s) {
-    if (c == '\'') out += '\'';
-    out += c == '\n' || c == '\r' ? ' ' : c;
+Json RunOutput::draw_run_plots(Json& notes) {
+  // A quantity that is 0 throughout gets a sentence, not a flat line (drop_zero_series).
+  std::vector<Plot> to_draw;
+  Json plots = Json::object();
+  for (Plot& plot : plots_) {
+    std::string dropped;
+    for (const std::string& note : drop_zero_series(dir_, plot)) {
+      notes.push_back(plot.name + ".png: " + note);
+      dropped += (dropped.empty() ? "" : "; ") + note;
+    }
+    if (has_series(plot))
+      to_draw.push_back(plot);
+    else
+      plots[plot.name] = "not drawn: " + dropped;
   }
-  return out + "'";
-}
-
-void write_axes(std::ostream& gp, const Plot& p) {
-  gp << "set title " << quote(p.title) << "\n"
-     << "set xlabel " << quote(p.xlabel) << "\n"
-     << "set ylabel " << quote(p.ylabel) << "\n"
-     << "plot ";
-  for (std::size_t i = 0; i < p.series.size(); ++i) {
-    const auto& s = p.series[i];
-    gp << (i ? ", \\\n     " : "") << quote(s.file) << " using " << quote(s.x) << ":" << quote(s.y)
-       << " with " << s.style << " lw 2 title " << quote(s.title);
+  std::vector<std::string> problems(
+      to_draw.size(), "gnuplot is not installed (scripts/deps.sh installs gnuplot-nox)");
+  const bool drawn = have_gnuplot();
+  if (drawn) problems = draw_plots(dir_, to_draw);
+  for (std::size_t i = 0; i < to_draw.size(); ++i) {
+    plots[to_draw[i].name] =
+        problems[i].empty() ? to_draw[i].name + ".png" : "not drawn: " + problems[i];
+    // A missing gnuplot is a note; a gnuplot that failed, a failure of the run.
+    if (drawn && !problems[i].empty())
+      failures_.push_back("plot " + to_draw[i].name + " not drawn: " + problems[i]);
   }
-  gp << "\n";
-}
-
-}  // namespace
-
-namespace {
-
-bool write_plot_script(const fs::path& dir, const Plot& plot, std::string& problem) {
-  const fs::path script = dir / (plot.name + ".gp");
-  std::ofstream gp(script);
-  if (!gp) {
-    problem = "cannot write " + script.string();
-    return false;
-  }
-  const int panels = std::max<int>(1, static_cast<int>(plot.panels.size()));
-  // `reset` first: the scripts run one after the other in one gnuplot (draw_plots).
-  gp << "# Drawn by conform from the CSV files beside it: gnuplot " << plot.name << ".gp\n"
-     << "reset\nset terminal pngcairo size " << (panels > 1 ? 600 * panels : 1000)
-     << ",600 enhanced font 'sans,11'\n"
-     << "set output " << quote(plot.name + ".png") << "\n"
-     << "set datafile separator ','\n"
-     << "set grid\nset key top left\n";
-  if (plot.panels.empty()) {
-    write_axes(gp, plot);
-  } else {
-    gp << "set multiplot layout 1," << panels << " title " << quote(plot.title) << "\n";
-    for (const auto& p : plot.panels) write_axes(gp, p);
-    gp << "unset multiplot\n";
-  }
-  gp << "unset output\n";  // the PNG is complete before the next script starts
-  if (!gp) problem = "cannot write " + script.string();
-  return bool(gp);
-}
-
-}  // namespace
-
-std::vector<std::string> draw_plots(const fs::path& dir, const std::vector<Plot>& plots) {
-  std::vector<std::string> problems(plots.size());
-  std::vector<std::string> args = {"gnuplot"};
-  for (std::size_t i = 0; i < plots.size(); ++i)
-    if (write_plot_script(dir, plots[i], problems[i])) args.push_back(plots[i].name + ".gp");
-  if (args.size() == 1) return problems;
-  // One gnuplot for all: its start-up (fonts, cairo) is most of a small plot's cost.
-  const fs::path log = fs::absolute(dir / "plots.log");
-  ChildOptions options;
-  options.log = log.string();
-  options.dir = fs::absolute(dir).string();
-  ChildProcess gnuplot(args, options);
-  const bool ok = gnuplot.running() && gnuplot.wait() == 0;
-  check_interrupt();
-  // gnuplot stops at the first failing script: what came before it was drawn.
-  for (std::size_t i = 0; i < plots.size(); ++i)
-    if (problems[i].empty() && (!ok || !fs::exists(dir / (plots[i].name + ".png"))))
-      problems[i] = "gnuplot failed (see plots.log in the output folder)";
-  if (ok) fs::remove(log);
-  return problems;
-}
-
-bool have_gnuplot() {
-  return have_tool("gnuplot");
+  return plots;
 }
 
 fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int steps,
@@ -257,19 +204,8 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   if (pictures_) pictures_->start();
   Json plots = Json::object();
   const auto plots_start = Clock::now();
-  if (common_.plots) {
-    std::vector<std::string> problems(
-        plots_.size(), "gnuplot is not installed (scripts/deps.sh installs gnuplot-nox)");
-    const bool drawn = have_gnuplot();
-    if (drawn) problems = draw_plots(dir_, plots_);
-    for (std::size_t i = 0; i < plots_.size(); ++i) {
-      plots[plots_[i].name] =
-          problems[i].empty() ? plots_[i].name + ".png" : "not drawn: " + problems[i];
-      // A missing gnuplot is a note; a gnuplot that failed, a failure of the run.
-      if (drawn && !problems[i].empty())
-        failures_.push_back("plot " + plots_[i].name + " not drawn: " + problems[i]);
-    }
-  }
+  Json plot_notes = Json::array();
+  if (common_.plots) plots = draw_run_plots(plot_notes);
   const double plots_ms =
       std::chrono::duration<double, std::milli>(Clock::now() - plots_start).count();
   const Json render = finish_render(render_start, plots_ms, loop_seconds, steps);
@@ -302,6 +238,7 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   summary["metrics"] = metrics;
   summary["frames"] = frames_;
   summary["plots"] = plots;
+  if (!plot_notes.empty()) summary["plot_notes"] = plot_notes;
   summary["render"] = render;
   summary["failures"] = failures_;
   // Settings, timings and what the scene added: JSON would hold NaN or inf as null.

@@ -8,6 +8,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -17,25 +18,10 @@
 #include "base/scene_config.hpp"
 #include "conform/mesh/skinned_mesh.hpp"
 #include "render/frame_snapshot.hpp"
+#include "render/plots.hpp"
 #include "render/render_settings.hpp"
 
 namespace conform::scenes {
-
-/// One line of a gnuplot figure: a CSV column against another.
-struct PlotSeries {
-  std::string file = "metrics.csv";  // relative to the run folder
-  std::string x, y;                  // column names
-  std::string title;
-  std::string style = "lines";
-};
-
-struct Plot {
-  std::string name;  // file stem: NAME.png (and NAME.gp, the script that drew it)
-  std::string title, xlabel, ylabel;
-  std::vector<PlotSeries> series;
-  /// Several panels side by side (multiplot), each with its own series; overrides `series`.
-  std::vector<Plot> panels;
-};
 
 /// Common settings every scene reads (physics, outputs, seed, length).
 /// The most steps a run may take (duration / dt or --steps): 10^8 keeps every step count and
@@ -84,6 +70,9 @@ class RunOutput {
   /// A CSV file in the run folder with the given header; rows are appended with row().
   class Csv {
    public:
+    /// A value that does not exist at this row (the hand piece before the cut): written as an
+    /// empty field, never as 0.
+    static constexpr double kAbsent = std::numeric_limits<double>::quiet_NaN();
     Csv(const std::filesystem::path& path, std::vector<std::string> columns);
     void row(std::span<const double> values);
     std::size_t columns() const { return columns_.size(); }
@@ -120,6 +109,9 @@ class RunOutput {
   const std::vector<std::string>& failures() const { return failures_; }
 
  private:
+  /// Draws the plots (each series that is 0 throughout left out, a sentence in `notes`); their
+  /// report for summary.json.
+  Json draw_run_plots(Json& notes);
   /// The pictures (started at t0, while plots took plots_ms), the video and run.glb; their
   /// report for summary.json.
   Json finish_render(Clock::time_point t0, double plots_ms, double loop_seconds, int steps);
@@ -137,16 +129,6 @@ class RunOutput {
   std::unique_ptr<Progress> progress_;
   std::vector<std::string> failures_;
 };
-
-/// Draws each plot into dir/NAME.png (its script kept as dir/NAME.gp; series files relative to
-/// `dir`), all in one gnuplot process; returns each plot's problem ("" when drawn). RunOutput
-/// and `conform sweep` draw through this one function. Every title, label and file name is a
-/// single-quoted gnuplot string (no backquote substitution), and gnuplot is run from its
-/// argument vector, not through a shell.
-std::vector<std::string> draw_plots(const std::filesystem::path& dir,
-                                    const std::vector<Plot>& plots);
-/// Whether gnuplot is on the PATH.
-bool have_gnuplot();
 
 /// Reads the common keys (scene, seed, duration, physics, outputs) of a scene object.
 CommonSettings read_common(Reader& root, const std::string& name, double default_duration,

@@ -166,8 +166,8 @@ class MembraneSlit final : public Scene {
     out.add_plot({"convergence",
                   "membrane-slit: largest opening over time",
                   "time [s]",
-                  "largest opening [m]",
-                  {{"metrics.csv", "t", "w_max", "w_max", "lines"}},
+                  "largest opening [µm]",
+                  {{"metrics.csv", "t", "w_max", "w_max (membrane)", "lines", 1e6}},
                   {}});
     Json metrics = {{"w_max", fit.w_max},
                     {"profile_r2", fit.r2},

@@ -184,7 +184,9 @@ class ArmEventScene : public Scene {
         continue;  // offsets are measured once the plugin has skinned the new vertices
       }
       const OffsetStats all = offsets(body, {});
-      OffsetStats sp{}, rs{};
+      // The hand piece (or the rim) and the rest do not exist before the event: blank, not 0.
+      constexpr double absent = RunOutput::Csv::kAbsent;
+      OffsetStats sp{absent, absent}, rs{absent, absent};
       if (!special.empty()) {
         sp = offsets(body, special);
         rs = offsets(body, others);
@@ -288,24 +290,16 @@ class ArmEventScene : public Scene {
 
   void add_plot(RunOutput& out) const {
     const bool is_cut = kind_ == Kind::cut;
-    out.add_plot({"offsets",
-                  is_cut ? "cut: distance of nodes from their skinned targets"
-                         : "drill: distance of nodes from their skinned targets",
-                  "time [s]",
-                  "distance from skinned target [m]",
-                  is_cut ? std::vector<PlotSeries>{{"metrics.csv", "t", "offset_mean",
-                                                    "all nodes (mean)", "lines"},
-                                                   {"metrics.csv", "t", "hand_offset_mean",
-                                                    "hand piece (mean)", "lines"},
-                                                   {"metrics.csv", "t", "hand_offset_max",
-                                                    "hand piece (max)", "lines"}}
-                         : std::vector<PlotSeries>{{"metrics.csv", "t", "offset_mean",
-                                                    "all nodes (mean)", "lines"},
-                                                   {"metrics.csv", "t", "rim_offset_mean",
-                                                    "hole rim (mean)", "lines"},
-                                                   {"metrics.csv", "t", "rim_offset_max",
-                                                    "hole rim (max)", "lines"}},
-                  {}});
+    const std::string what = is_cut ? "hand" : "rim", name = is_cut ? "hand piece" : "hole rim";
+    // In mm; the piece's lines start at the event (blank before it), which a dashed line marks.
+    Plot plot("offsets",
+              std::string(is_cut ? "cut" : "drill") + ": distance of nodes from their targets",
+              "time [s]", "distance from the CGA-skinned target [mm]", {});
+    plot.series = {{"metrics.csv", "t", "offset_mean", "all nodes (mean)", "lines", 1e3},
+                   {"metrics.csv", "t", what + "_offset_mean", name + " (mean)", "lines", 1e3},
+                   {"metrics.csv", "t", what + "_offset_max", name + " (max)", "lines", 1e3}};
+    plot.events = {{at_, is_cut ? "cut" : "drill"}};
+    out.add_plot(std::move(plot));
   }
 
  private:

@@ -1,14 +1,15 @@
 #include "sweep/sweep_plots.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <map>
 #include <sstream>
 
-#include "kinds/run_output.hpp"
 #include "kinds/scene.hpp"
+#include "render/plots.hpp"
 
 namespace conform::scenes {
 
@@ -61,6 +62,18 @@ std::string file_stem(const std::string& s) {
   return out;
 }
 
+// A tic at each value of an axis of a few whole numbers (resolutions, substeps), so that gnuplot
+// does not label 1.5 between 1 and 2; none (gnuplot's own) otherwise.
+std::vector<double> whole_number_tics(const std::vector<std::string>& values) {
+  std::vector<double> tics;
+  for (const auto& value : values) {
+    double v = 0;
+    if (!numeric(value, v) || v != std::round(v)) return {};
+    tics.push_back(v);
+  }
+  return tics.size() <= 20 ? tics : std::vector<double>{};
+}
+
 // One line: mean of the metric over the rows with the same x (the repeats).
 using Line = std::map<double, std::pair<double, int>>;
 
@@ -99,6 +112,7 @@ Plot sweep_plot(const SweepSpec& spec, const SweepTable& table, std::size_t x,
                 const std::string& metric, const fs::path& plots_dir) {
   const std::string& key = spec.axes[x].key;
   Plot plot;
+  plot.enhanced_text = true;  // keys and values are escaped as enhanced text (literal)
   plot.name = file_stem(metric) + "_vs_" + file_stem(key);
   std::string units;
   for (const auto& r : table.rows) units = units.empty() ? r.units : units;
@@ -107,6 +121,7 @@ Plot sweep_plot(const SweepSpec& spec, const SweepTable& table, std::size_t x,
   plot.xlabel = literal(key);
   plot.ylabel = literal(metric) +
                 (spec.repeat > 1 ? " (mean of " + std::to_string(spec.repeat) + " seeds)" : "");
+  plot.x_tics = whole_number_tics(spec.axes[x].values);
   int n = 0;
   for (const auto& [title, line] : lines_of(spec, table, x, metric)) {
     const std::string data = "data/" + plot.name + "_" + std::to_string(n++) + ".csv";
