@@ -158,7 +158,7 @@ Json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, const CutEdi
   return event;
 }
 
-void TearRun::advance(bullet::SkinnedSoftBody& body, double t) {
+void TearRun::advance(bullet::SkinnedSoftBody& body, double t, GeometricTear* copy) {
   for (; next_ < edit_.samples && event_due(t, edit_.time(next_)); ++next_) {
     const double u = edit_.samples > 1 ? double(next_) / (edit_.samples - 1) : 0.0;
     const Vec3 p = bind_.point((1 - u) * edit_.from + u * edit_.to);
@@ -167,6 +167,7 @@ void TearRun::advance(bullet::SkinnedSoftBody& body, double t) {
     const mesh::ScalpelSample s{t, carrier.point(p + bind_.offset(edit_.blade_a)),
                                 carrier.point(p + bind_.offset(edit_.blade_b))};
     extended_ += body.tear_advance(s).extended;
+    if (copy) copy->advance(s);
     const mesh::Tear* tear = body.tear();
     if (next_ + 1 == edit_.samples && tear && tear->started()) {
       // Where the tear ends against where the blade ended: the segment's nearest point.

@@ -24,6 +24,7 @@
 
 #include "base/scene_config.hpp"
 #include "conform/bullet/skinned_soft_body.hpp"
+#include "kinds/geometric_tear.hpp"
 
 namespace conform::scenes {
 
@@ -107,8 +108,10 @@ nlohmann::json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, co
 class TearRun {
  public:
   TearRun(const TearEdit& edit, const BindPose& bind) : edit_(edit), bind_(bind) {}
-  /// Advances every sample whose time is ≤ t (at the body's last pose).
-  void advance(bullet::SkinnedSoftBody& body, double t);
+  /// Advances every sample whose time is ≤ t (at the body's last pose), on the body and, when
+  /// given, the same sample on its geometric copy (posed as the body's last pose).
+  void advance(bullet::SkinnedSoftBody& body, double t, GeometricTear* copy = nullptr);
+  bool started() const { return next_ > 0; }
   bool done() const { return next_ >= edit_.samples; }
   /// Its summary entry (samples, steps that extended the tear, length, message).
   nlohmann::json summary(const bullet::SkinnedSoftBody& body) const;

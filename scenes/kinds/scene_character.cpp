@@ -3,16 +3,22 @@
 // (character_edits.hpp places the edits on the model). Reported: the soft nodes' distance from
 // their skinned targets, the first step's speed against the animation's, every edit, and the
 // gap across the seams that the import's weld closed (vertices of the file at one rest
-// position), relative to the model's diagonal.
+// position), relative to the model's diagonal. The tear's physical opening is compared with
+// its geometric one, as tear-opening does on the arm: the same samples on the animated mesh
+// alone (skinned, no physics; geometric_tear.hpp), opened by Algorithm 2 step 6 once the stroke
+// is done; their gap-width profiles over time (opening_profiles.hpp).
 #include <chrono>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "conform/io/import.hpp"
 #include "conform/io/weld_model.hpp"
 #include "kinds/character_edits.hpp"
 #include "kinds/event_time.hpp"
+#include "kinds/geometric_tear.hpp"
 #include "kinds/model_frame.hpp"
+#include "kinds/opening_profiles.hpp"
 #include "kinds/scene.hpp"
 #include "kinds/soft_scene.hpp"
 
@@ -22,7 +28,7 @@ namespace {
 // The built-in scene `character`, the defaults of this kind (`conform scenes --show character`).
 constexpr const char* kCharacterJson = R"json({
   "scene": "character",
-  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body (nodes close to one bone ride it, blended regions follow their skinned targets softly) and, while it plays, its arm is cut off with a capped cut, its flank torn by a scalpel stroke and its base drilled through with a tube; the welded seams are measured for gaps. Units: the model is brought to metres, Y up, at import: model.units_per_metre file units make a metre (\"file\": the unit the file states, FBX's UnitScaleFactor, else 100), model.up (y or z) is the file's up axis (z is turned to y). Edits are placed on the bind pose: cut.point, cut.seed, tear.from, tear.to, drill.tip and drill.base as fractions of its bounding box, tear.blade_a and tear.blade_b as fractions of its size, drill.radius as a fraction of its diagonal, cut.normal in its axes (after model.up); material.margin is in metres, physics.gravity in m/s^2; every length in summary.json is in metres. model.animation = none plays the bind pose (what a model without animation does). cut.region = nearest cuts only the section of the plane nearest cut.seed (by default cut.point), everywhere the unbounded plane.",
+  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body (nodes close to one bone ride it, blended regions follow their skinned targets softly) and, while it plays, its arm is cut off with a capped cut, its flank torn by a scalpel stroke and its base drilled through with a tube; the welded seams are measured for gaps. Units: the model is brought to metres, Y up, at import: model.units_per_metre file units make a metre (\"file\": the unit the file states, FBX's UnitScaleFactor, else 100), model.up (y or z) is the file's up axis (z is turned to y). Edits are placed on the bind pose: cut.point, cut.seed, tear.from, tear.to, drill.tip and drill.base as fractions of its bounding box, tear.blade_a and tear.blade_b as fractions of its size, drill.radius as a fraction of its diagonal, cut.normal in its axes (after model.up); material.margin is in metres, physics.gravity in m/s^2; every length in summary.json is in metres. model.animation = none plays the bind pose (what a model without animation does). cut.region = nearest cuts only the section of the plane nearest cut.seed (by default cut.point), everywhere the unbounded plane. The tear's physical opening is compared with a geometric copy: the same stroke on the animated mesh alone (CGA-skinned, no physics; the cut and the drill are not applied to it), opened by Algorithm 2 step 6 once the stroke ends by geometric.amount, a fraction of the bind pose's diagonal (summary.json: metrics.physics and metrics.geometric, max_opening in metres); profiles.points positions along the tear, profiles.snapshots profile snapshots (profiles.csv, profile_history.csv, geometric_*.ply frames, two-panel pictures).",
   "seed": 1,
   "duration": 1.56,
   "model": { "file": "/usr/share/assimp/models/FBX/huesitos.fbx", "animation": "0",
@@ -35,6 +41,8 @@ constexpr const char* kCharacterJson = R"json({
             "to": [0.3, 0.75, 1.0], "blade_a": [0, 0, 0.3], "blade_b": [0, 0, -0.45] },
   "drill": { "at": 1.1, "tip": [0.6, 0.2, 0.68], "base": [-0.2, 0.2, 0.68], "radius": 0.03,
              "tube": true },
+  "geometric": { "amount": 0.01 },
+  "profiles": { "snapshots": 6, "points": 41 },
   "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
                "gravity": [0, -9.81, 0] },
   "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
@@ -76,6 +84,25 @@ struct RunState {
   Json cut, tear, drill;
   bool cut_done = false, drill_done = false;
   double edit_ms = 0, physics_ms = 0;
+};
+
+// The tear's physical opening against its geometric copy, with the largest of each so far.
+struct TearCompare {
+  GeometricTear geo;
+  OpeningProfiles profiles;
+  Profile phys, geom;
+  double max_phys = 0, max_geom = 0, ms = 0;  // ms: posing (skinning) and opening the copy
+  TearCompare(const mesh::SkinnedMesh& bind_mesh, OpeningProfiles kept)
+      : geo(bind_mesh, mesh::TearOptions{}), profiles(std::move(kept)) {}
+
+  // Both profiles now (each kept as it was while its tear has under two points).
+  void measure(const bullet::SkinnedSoftBody& body) {
+    const mesh::Tear* pt = body.tear();
+    if (pt && pt->path_length() >= 2) phys = physical_profile(body);
+    if (geo.tear().path_length() >= 2) geom = geo.profile();
+    max_phys = std::max(max_phys, phys.max);
+    max_geom = std::max(max_geom, geom.max);
+  }
 };
 
 class Character final : public Scene {
@@ -120,6 +147,15 @@ class Character final : public Scene {
     cut_ = read_cut(root);
     tear_ = read_tear(root);
     drill_ = read_drill(root);
+    // The geometric copy's opening, a fraction of the bind pose's diagonal (as every length
+    // placed on the model), and the profiles kept of both openings (tear-opening's keys).
+    Reader geo = root.object("geometric");
+    amount_ = geo.number("amount", 0.01, 0, 1);
+    geo.finish();
+    Reader prof = root.object("profiles");
+    snapshots_ = prof.integer("snapshots", 6, 1, 100);
+    points_ = prof.integer("points", 41, 3, 10000);
+    prof.finish();
     common_ = read_common(root, name, 3.0, steps_override);
     root.finish();
   }
@@ -152,12 +188,21 @@ class Character final : public Scene {
     const BindPose bind(model.mesh);
     const SeamGap seams(file_rest, file_faces, mesh_of, weld.vertex_map);
     TearRun tear(tear_, bind);
+    std::optional<TearCompare> compare;
+    if (tear_.enabled)
+      compare.emplace(model.mesh, OpeningProfiles(points_, snapshots_, tear_.at, c.steps, c.dt));
     std::vector<Eigen::Vector3d> start_targets(static_cast<std::size_t>(body.vertex_count()));
     for (std::int32_t v = 0; v < body.vertex_count(); ++v)
       start_targets[static_cast<std::size_t>(v)] = body.target(v);
     std::int32_t kinematic = 0;
     for (std::int32_t v = 0; v < body.vertex_count(); ++v) kinematic += body.kinematic(v);
-    out.open_metrics({"t", "offset_mean_m", "offset_max_m", "seam_gap_rel", "pieces", "nodes"});
+    std::vector<std::string> columns{"t",      "offset_mean_m", "offset_max_m", "seam_gap_rel",
+                                     "pieces", "nodes"};
+    if (compare)
+      columns.insert(columns.end(), {"physics_max_opening", "geometric_max_opening", "physics_area",
+                                     "geometric_area"});
+    out.open_metrics(columns);
+    if (compare) compare->profiles.open_history(out);
     RunState s;
     out.frame("character", 0, body.mesh());
     const auto loop_start = Clock::now();
@@ -167,25 +212,30 @@ class Character final : public Scene {
       s.physics_ms += std::chrono::duration<double, std::milli>(Clock::now() - tp).count();
       if (step == 1) s.first = first_step(body, start_targets, c.dt);
       const auto te = Clock::now();
-      edit(body, bind, tear, step * c.dt, s);
+      edit(body, bind, tear, compare ? &*compare : nullptr, step * c.dt, s);
       s.edit_ms += std::chrono::duration<double, std::milli>(Clock::now() - te).count();
-      measure(body, seams, bind, step, c, s, out);
-      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
-        body.sync_mesh();
-        out.frame("character", step, body.mesh());
-      }
+      measure(body, seams, bind, tear, compare ? &*compare : nullptr, step, c, s, out);
+      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps)
+        write_frame(body, compare ? &*compare : nullptr, step, out);
       out.progress(step, c.steps);
     }
     const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
     if (!finite_nodes(body)) throw std::runtime_error("the soft body blew up (non-finite nodes)");
     if (tear_.enabled) s.tear = tear.summary(body);
     Json metrics = summarize(body, model, animation, weld, seams, bind, kinematic, c, s);
+    Json timings = {{"model_vertices", model.mesh.vertex_count()},
+                    {"physics_ms_per_step", s.physics_ms / c.steps},
+                    {"edits_ms", s.edit_ms}};
     add_plots(out);
-    out.finish(resolved_, metrics,
-               {{"model_vertices", model.mesh.vertex_count()},
-                {"physics_ms_per_step", s.physics_ms / c.steps},
-                {"edits_ms", s.edit_ms}},
-               c.steps, c.steps * c.dt, loop_s);
+    if (compare) {
+      add_comparison(*compare, body, bind, metrics);
+      timings["geometric_copy_ms"] = compare->ms;
+      compare->profiles.write(out);
+      compare->profiles.add_plots(out, "character", "physics (Bullet soft body)",
+                                  "geometric (skinned mesh, Algorithm 2 step 6)",
+                                  "geometric (step 6)");
+    }
+    out.finish(resolved_, metrics, timings, c.steps, c.steps * c.dt, loop_s);
     return metrics;
   }
 
@@ -238,14 +288,14 @@ class Character final : public Scene {
   }
 
   // The edits due at time t (between steps, at the body's last pose).
-  void edit(bullet::SkinnedSoftBody& body, const BindPose& bind, TearRun& tear, double t,
-            RunState& s) const {
+  void edit(bullet::SkinnedSoftBody& body, const BindPose& bind, TearRun& tear,
+            TearCompare* compare, double t, RunState& s) const {
     if (cut_.enabled && !s.cut_done && event_due(t, cut_.at)) {
       s.cut = apply_cut(body, bind, cut_);
       s.cut_done = true;
       if (s.cut["status"] != "cut") std::cerr << "warning: the cut missed the model\n";
     }
-    if (tear_.enabled && !tear.done()) tear.advance(body, t);
+    if (tear_.enabled) advance_tear(body, bind, tear, compare, t);
     if (drill_.enabled && !s.drill_done && event_due(t, drill_.at)) {
       s.drill = apply_drill(body, bind, drill_);
       s.drill_done = true;
@@ -253,17 +303,72 @@ class Character final : public Scene {
     }
   }
 
+  // The tear on the body and on its geometric copy, which is first posed as the body's last
+  // pose (the animation's: the skeleton owes nothing to the physics) and opened by
+  // geometric.amount of the diagonal once the stroke is done.
+  void advance_tear(bullet::SkinnedSoftBody& body, const BindPose& bind, TearRun& tear,
+                    TearCompare* compare, double t) const {
+    if (!compare) {
+      if (!tear.done()) tear.advance(body, t);
+      return;
+    }
+    const auto t0 = Clock::now();
+    compare->geo.repose(body.skeleton(), body.pose(), body.world_transform());
+    compare->ms += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+    if (!tear.done()) tear.advance(body, t, &compare->geo);
+    if (tear.done() && !compare->geo.opened()) compare->geo.open(amount_ * bind.diagonal());
+  }
+
   void measure(const bullet::SkinnedSoftBody& body, const SeamGap& seams, const BindPose& bind,
-               int step, const CommonSettings& c, RunState& s, RunOutput& out) const {
+               const TearRun& tear, TearCompare* compare, int step, const CommonSettings& c,
+               RunState& s, RunOutput& out) const {
     const OffsetStats o = offsets(body, {});
     s.worst_offset = std::max(s.worst_offset, o.max), s.mean_offset_sum += o.mean;
     const double gap = seams.measure(body) / bind.diagonal();
     s.worst_seam_gap = std::max(s.worst_seam_gap, gap);
+    const double t = step * c.dt;
+    if (compare) compare->measure(body);
     if (step % c.metrics_every == 0 || step == c.steps) {
-      const double row[] = {
-          step * c.dt, o.mean, o.max, gap, double(body.piece_count()), double(body.vertex_count())};
+      std::vector<double> row{
+          t, o.mean, o.max, gap, double(body.piece_count()), double(body.vertex_count())};
+      if (compare) {
+        const TearCompare& k = *compare;
+        row.insert(row.end(), {k.phys.max, k.geom.max, k.phys.area, k.geom.area});
+        if (tear.started()) compare->profiles.history_row(t, k.phys, k.geom);
+      }
       out.metrics().row(row);
     }
+    if (compare) compare->profiles.snapshot(step, t, compare->phys, compare->geom);
+  }
+
+  // The body's frame and, with the comparison, the geometric copy's and their picture.
+  static void write_frame(bullet::SkinnedSoftBody& body, const TearCompare* compare, int step,
+                          RunOutput& out) {
+    body.sync_mesh();
+    out.frame("character", step, body.mesh());
+    if (!compare) return;
+    out.frame("geometric", step, compare->geo.mesh());
+    // The physical panel is named as its frames, so run.glb keeps one sequence of the body.
+    out.picture(step, {{"character", &body.mesh(), tear_lips(body.tear())},
+                       {"geometric", &compare->geo.mesh(), tear_lips(&compare->geo.tear())}});
+  }
+
+  // metrics.physics and metrics.geometric: each opening at the end and its largest over the
+  // run (metres), the opened area and the profile's elliptical fit (the rest length of
+  // tear-opening is left out: an imported model's rest space need not be in metres).
+  void add_comparison(const TearCompare& k, const bullet::SkinnedSoftBody& body,
+                      const BindPose& bind, Json& m) const {
+    const auto part = [](const Profile& p, double largest, const mesh::Tear* tear) {
+      return Json{{"max_opening", p.max},         {"max_opening_over_time", largest},
+                  {"opened_area", p.area},        {"profile_r2", p.r2},
+                  {"profile_fit_max", p.fit_max}, {"tear_points", tear ? tear->path_length() : 0}};
+    };
+    m["physics"] = part(k.phys, k.max_phys, body.tear());
+    m["geometric"] = part(k.geom, k.max_geom, &k.geo.tear());
+    m["geometric"]["amount"] = amount_;                      // of the bind pose's diagonal
+    m["geometric"]["amount_m"] = amount_ * bind.diagonal();  // metres
+    m["physics_over_geometric_max_opening"] = k.geom.max > 0 ? k.phys.max / k.geom.max : 0.0;
+    m["opening_units"] = "metres, square metres; profile_r2 of w_max*sqrt(1-(2s-1)^2)";
   }
 
   Json summarize(const bullet::SkinnedSoftBody& body, const io::SkinnedModel& model,
@@ -340,6 +445,8 @@ class Character final : public Scene {
   CutEdit cut_;
   TearEdit tear_;
   DrillEdit drill_;
+  double amount_ = 0.01;  // geometric.amount, of the bind pose's diagonal
+  int snapshots_ = 6, points_ = 41;
 };
 
 std::unique_ptr<Scene> make_character(const Json& scene, const std::string& name, int steps) {

@@ -21,6 +21,8 @@
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 #include "kinds/event_time.hpp"
+#include "kinds/geometric_tear.hpp"
+#include "kinds/opening_profiles.hpp"
 #include "kinds/scene.hpp"
 #include "kinds/soft_scene.hpp"
 
@@ -119,16 +121,14 @@ class TearOpening final : public Scene {
                        stroke_.time(stroke_.samples - 1));
     if (flex_deg_ != 0) require_before_end(c, "pose.flex_at", flex_at_, "the flex", flex_at_);
     skin::Pose pose;
-    TearRun r(posed_arm(pose), pose, c, material_);
+    TearRun r(posed_arm(pose), pose, c, material_,
+              OpeningProfiles(bins_, snapshots_, stroke_.at, c.steps, c.dt));
     r.body.set_pose_source(flexing_pose(pose));
-    r.bins = profile_positions();
-    r.snapshot_steps = snapshot_steps();
     out.open_metrics({"t", "physics_tear_points", "geometric_tear_points", "physics_max_opening",
                       "geometric_max_opening", "physics_area", "geometric_area",
                       "physics_profile_r2", "geometric_profile_r2", "pieces",
                       "physics_newton_iterations", "physics_cg_iterations", "physics_residual"});
-    RunOutput::Csv history =
-        out.open_csv("profile_history.csv", {"t", "s", "physics_width", "geometric_width"});
+    r.profiles.open_history(out);
     out.frame("physics", 0, r.body.mesh());
     const auto loop_start = Clock::now();
     for (int step = 1; step <= c.steps; ++step) {
@@ -136,20 +136,21 @@ class TearOpening final : public Scene {
       const double t = step * c.dt;
       note_solve(r, t);
       r.tear_ms += milliseconds([&] { advance_stroke(r, t); });  // edits only between steps
-      r.measure_ms += milliseconds([&] { measure(r, step, t, out, history); });
+      r.measure_ms += milliseconds([&] { measure(r, step, t, out); });
       if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
         r.body.sync_mesh();
         out.frame("physics", step, r.body.mesh());
-        out.frame("geometric", step, r.geo);
-        out.picture(step, {{"physics", &r.body.mesh(), lips(r.body.tear())},
-                           {"geometric", &r.geo, lips(&r.geo_tear)}});
+        out.frame("geometric", step, r.geo.mesh());
+        out.picture(step, {{"physics", &r.body.mesh(), tear_lips(r.body.tear())},
+                           {"geometric", &r.geo.mesh(), tear_lips(&r.geo.tear())}});
       }
       out.progress(step, c.steps);
     }
     const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
     check_torn(r);
-    write_profiles(r, out);
-    add_plots(r, out);
+    r.profiles.write(out);
+    r.profiles.add_plots(out, "tear-opening", "physics (pre-stressed skin membrane in Bullet)",
+                         "geometric (Algorithm 2 step 6)", "geometric (step 6)");
     const Json metrics = summary(r);
     out.finish(resolved_, metrics, timings(r), c.steps, c.steps * c.dt, loop_s);
     return metrics;
@@ -160,18 +161,12 @@ class TearOpening final : public Scene {
   // as a soft body (physics), and what is measured along the way.
   struct TearRun {
     mesh::Arm arm;
-    mesh::SkinnedMesh geo;  // the geometric run: the mesh alone
-    mesh::Adjacency geo_adjacency;
-    mesh::Tear geo_tear;
-    SoftWorld world;  // the physics run
+    GeometricTear geo;  // the geometric run: the mesh alone
+    SoftWorld world;    // the physics run
     double build_ms = 0;
     bullet::SkinnedSoftBody& body;
-    std::vector<double> bins;         // normalized positions along the tear where profiles are kept
-    std::vector<int> snapshot_steps;  // steps whose profiles go into profiles.csv
-    std::vector<std::vector<double>> snap_physics, snap_geometric;
-    std::vector<double> snap_times;
+    OpeningProfiles profiles;
     int next = 0;  // the next stroke sample
-    bool opened = false;
     Profile phys, geom;
     double max_phys = 0, max_geom = 0, tear_ms = 0, measure_ms = 0, physics_ms = 0;
     int tear_steps = 0;
@@ -179,13 +174,12 @@ class TearOpening final : public Scene {
     int unconverged = 0;
 
     TearRun(mesh::Arm posed, const skin::Pose& pose, const CommonSettings& c,
-            const bullet::Material& material)
+            const bullet::Material& material, OpeningProfiles kept)
         : arm(std::move(posed)),
-          geo(arm.mesh),
-          geo_adjacency(geo),
-          geo_tear(geo, geo_adjacency, lips()),
+          geo(arm.mesh, lips()),
           world(c),
-          body(add_body(world, arm, material, build_ms)) {
+          body(add_body(world, arm, material, build_ms)),
+          profiles(std::move(kept)) {
       body.set_pose(pose);
       body.begin_tear(lips());
     }
@@ -209,12 +203,6 @@ class TearOpening final : public Scene {
     const auto t0 = Clock::now();
     f();
     return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-  }
-
-  // A tear's two borders, the wound the pictures aim at (none before the tear began).
-  static Lips lips(const mesh::Tear* tear) {
-    if (!tear || tear->path_length() < 2) return {};
-    return {tear->left_border(), tear->right_border()};
   }
 
   // The arm with its elbow flexed; both runs start from this posed (skinned) arm.
@@ -257,62 +245,30 @@ class TearOpening final : public Scene {
     if (t <= flex_at_ + 1e-12) r.before_flex = r.phys.max;
   }
 
-  // The stroke's points along the rest-space tear.
-  std::vector<double> profile_positions() const {
-    std::vector<double> bins(static_cast<std::size_t>(bins_));
-    for (int i = 0; i < bins_; ++i) bins[static_cast<std::size_t>(i)] = double(i) / (bins_ - 1);
-    return bins;
-  }
-
-  // The steps whose profiles are kept: denser early on, where the opening changes fastest.
-  std::vector<int> snapshot_steps() const {
-    const CommonSettings& c = common_;
-    const double end_time = c.steps * c.dt;
-    std::vector<int> steps;
-    for (int k = 0; k < snapshots_; ++k) {
-      const double u = double(k + 1) / snapshots_;
-      const double t = stroke_.at + (end_time - stroke_.at) * u * u;
-      steps.push_back(std::clamp(static_cast<int>(std::lround(t / c.dt)), 1, c.steps));
-    }
-    return steps;
-  }
-
   // The stroke's samples due by time t cut both runs; Algorithm 2 step 6 opens the geometric
   // tear once the stroke is done.
   void advance_stroke(TearRun& r, double t) const {
     while (r.next < stroke_.samples && event_due(t, stroke_.time(r.next))) {
       const mesh::ScalpelSample sample = stroke_.sample(r.next);
       r.body.tear_advance(sample);
-      r.geo_tear.advance(sample);
+      r.geo.advance(sample);
       ++r.next, ++r.tear_steps;
     }
-    if (r.next == stroke_.samples && !r.opened) {
-      r.geo_tear.open(amount_);
-      r.opened = true;
-    }
+    if (r.next == stroke_.samples && !r.geo.opened()) r.geo.open(amount_);
   }
 
   // Both profiles now; a metrics row, the profile history and the snapshots when due.
-  void measure(TearRun& r, int step, double t, RunOutput& out, RunOutput::Csv& history) const {
-    const auto rest_of = [](const mesh::SkinnedMesh& m) {
-      return [&m](std::int32_t v) { return Vec3(m.rest.col(v)); };
-    };
+  void measure(TearRun& r, int step, double t, RunOutput& out) const {
     const mesh::Tear* pt = r.body.tear();
-    if (pt && pt->path_length() >= 2)
-      r.phys = measure_profile(
-          pt->left_border(), pt->right_border(), [&](std::int32_t v) { return r.body.position(v); },
-          rest_of(r.body.mesh()));
-    if (r.geo_tear.path_length() >= 2)
-      r.geom = measure_profile(
-          r.geo_tear.left_border(), r.geo_tear.right_border(),
-          [&](std::int32_t v) { return Vec3(r.geo.current.col(v)); }, rest_of(r.geo));
+    if (pt && pt->path_length() >= 2) r.phys = physical_profile(r.body);
+    if (r.geo.tear().path_length() >= 2) r.geom = r.geo.profile();
     r.max_phys = std::max(r.max_phys, r.phys.max);
     r.max_geom = std::max(r.max_geom, r.geom.max);
     if (step % common_.metrics_every == 0 || step == common_.steps) {
       const membrane::SolveReport& solve = r.body.last_solve();  // the step's last substep
       const double row[] = {t,
                             double(pt ? pt->path_length() : 0),
-                            double(r.geo_tear.path_length()),
+                            double(r.geo.tear().path_length()),
                             r.phys.max,
                             r.geom.max,
                             r.phys.area,
@@ -324,20 +280,9 @@ class TearOpening final : public Scene {
                             double(solve.cg_iterations),
                             solve.residual};
       out.metrics().row(row);
-      if (r.next > 0) {
-        const auto pw = resample(r.phys, r.bins), gw = resample(r.geom, r.bins);
-        for (std::size_t i = 0; i < r.bins.size(); ++i) {
-          const double h[] = {t, r.bins[i], pw[i], gw[i]};
-          history.row(h);
-        }
-      }
+      if (r.next > 0) r.profiles.history_row(t, r.phys, r.geom);
     }
-    for (const int s : r.snapshot_steps)
-      if (s == step) {
-        r.snap_times.push_back(t);
-        r.snap_physics.push_back(resample(r.phys, r.bins));
-        r.snap_geometric.push_back(resample(r.geom, r.bins));
-      }
+    r.profiles.snapshot(step, t, r.phys, r.geom);
   }
 
   // A run whose scalpel never tore a run measured nothing: an error naming what it missed.
@@ -353,76 +298,9 @@ class TearOpening final : public Scene {
                                (pt ? pt->message() : std::string("no tear")) + "; " + box.str() +
                                ")");
     }
-    if (r.geo_tear.path_length() < 2)
+    if (r.geo.tear().path_length() < 2)
       throw std::runtime_error("tear-opening: the scalpel never tore the mesh (" +
-                               r.geo_tear.message() + ")");
-  }
-
-  // profiles.csv's columns: s, then one per snapshot time for each run.
-  static std::vector<std::string> profile_columns(const TearRun& r) {
-    std::vector<std::string> cols{"s"};
-    char name[48];
-    for (const double t : r.snap_times) {
-      std::snprintf(name, sizeof name, "physics_%.2fs", t);
-      cols.push_back(name);
-    }
-    for (const double t : r.snap_times) {
-      std::snprintf(name, sizeof name, "geometric_%.2fs", t);
-      cols.push_back(name);
-    }
-    return cols;
-  }
-
-  // The snapshots side by side: one row per position along the tear.
-  static void write_profiles(const TearRun& r, RunOutput& out) {
-    RunOutput::Csv profiles = out.open_csv("profiles.csv", profile_columns(r));
-    for (std::size_t i = 0; i < r.bins.size(); ++i) {
-      std::vector<double> row{r.bins[i]};
-      for (const auto& p : r.snap_physics) row.push_back(p[i]);
-      for (const auto& g : r.snap_geometric) row.push_back(g[i]);
-      profiles.row(row);
-    }
-  }
-
-  static void add_plots(const TearRun& r, RunOutput& out) {
-    const std::vector<std::string> cols = profile_columns(r);
-    Plot side{"profiles", "tear-opening: gap-width profile along the tear over time", "", "", {},
-              {}};
-    Plot left{"",
-              "physics (pre-stressed skin membrane in Bullet)",
-              "position along the tear (0 = start, 1 = tip)",
-              "gap width [m]",
-              {},
-              {}};
-    Plot right{"",
-               "geometric (Algorithm 2 step 6)",
-               "position along the tear (0 = start, 1 = tip)",
-               "gap width [m]",
-               {},
-               {}};
-    char name[48];
-    for (std::size_t k = 0; k < r.snap_times.size(); ++k) {
-      std::snprintf(name, sizeof name, "t = %.2f s", r.snap_times[k]);
-      left.series.push_back({"profiles.csv", "s", cols[1 + k], name, "lines"});
-      right.series.push_back(
-          {"profiles.csv", "s", cols[1 + r.snap_times.size() + k], name, "lines"});
-    }
-    side.panels = {left, right};
-    out.add_plot(side);
-    out.add_plot({"opening",
-                  "tear-opening: largest gap width",
-                  "time [s]",
-                  "largest gap width [m]",
-                  {{"metrics.csv", "t", "physics_max_opening", "physics", "lines"},
-                   {"metrics.csv", "t", "geometric_max_opening", "geometric (step 6)", "lines"}},
-                  {}});
-    out.add_plot({"area",
-                  "tear-opening: opened area",
-                  "time [s]",
-                  "opened area [m^2]",
-                  {{"metrics.csv", "t", "physics_area", "physics", "lines"},
-                   {"metrics.csv", "t", "geometric_area", "geometric (step 6)", "lines"}},
-                  {}});
+                               r.geo.tear().message() + ")");
   }
 
   Json summary(const TearRun& r) const {
@@ -437,7 +315,7 @@ class TearOpening final : public Scene {
     };
     Json metrics;
     metrics["physics"] = part(r.phys, r.max_phys, *r.body.tear());
-    metrics["geometric"] = part(r.geom, r.max_geom, r.geo_tear);
+    metrics["geometric"] = part(r.geom, r.max_geom, r.geo.tear());
     metrics["geometric"]["amount"] = amount_;
     const membrane::SolveReport& solve = r.body.last_solve();
     metrics["physics"]["residual"] = solve.residual;                    // Pa, the last substep's
