@@ -80,36 +80,75 @@ void OpeningProfiles::write(RunOutput& out) const {
   }
 }
 
-void OpeningProfiles::add_plots(RunOutput& out, const std::string& scene,
-                                const std::string& physics, const std::string& geometric,
-                                const std::string& geometric_short) const {
+namespace {
+
+double largest(const std::vector<double>& w) {
+  return w.empty() ? 0.0 : *std::max_element(w.begin(), w.end());
+}
+
+// The final profiles of both runs on the same axes, in mm, titled with their ratio: the
+// comparison the scenes exist for.
+Plot final_overlay(const std::string& scene, const std::string& physics_column,
+                   const std::string& geometric_column, double physics_max, double geometric_max,
+                   double t, const std::string& geometric) {
+  char title[200];
+  std::snprintf(title, sizeof title,
+                "%s: final gap-width profiles at t = %.2f s (largest: physics %.2f mm, "
+                "geometric %.2f mm, ratio %.2f)",
+                scene.c_str(), t, 1e3 * physics_max, 1e3 * geometric_max,
+                geometric_max > 0 ? physics_max / geometric_max : 0.0);
+  return {"final_profiles",
+          title,
+          "position along the tear (0 = start, 1 = tip)",
+          "gap width [mm]",
+          {{"profiles.csv", "s", physics_column, "physics", "lines", 1e3},
+           {"profiles.csv", "s", geometric_column, geometric, "lines", 1e3}}};
+}
+
+}  // namespace
+
+void OpeningProfiles::add_plots(RunOutput& out, const Labels& labels,
+                                const std::vector<PlotEvent>& events) const {
   const std::vector<std::string> cols = columns();
+  const std::size_t n = snap_times_.size();
   const std::string along = "position along the tear (0 = start, 1 = tip)";
-  Plot side{"profiles", scene + ": gap-width profile along the tear over time", "", "", {}, {}};
-  Plot left{"", physics, along, "gap width [m]", {}, {}};
-  Plot right{"", geometric, along, "gap width [m]", {}, {}};
+  if (n > 0)
+    out.add_plot(final_overlay(labels.scene, cols[n], cols[2 * n], largest(snap_physics_.back()),
+                               largest(snap_geometric_.back()), snap_times_.back(),
+                               labels.geometric));
+  // Both panels on one scale (in mm), so that their heights compare at a glance.
+  double top = 0;
+  for (std::size_t k = 0; k < n; ++k)
+    top = std::max({top, largest(snap_physics_[k]), largest(snap_geometric_[k])});
+  Plot side{"profiles", labels.scene + ": gap-width profile along the tear over time", "", "", {}};
+  Plot left{"", labels.physics, along, "gap width [mm]", {}};
+  Plot right{"", labels.geometric, along, "gap width [mm]", {}};
   char name[48];
-  for (std::size_t k = 0; k < snap_times_.size(); ++k) {
+  for (std::size_t k = 0; k < n; ++k) {
     std::snprintf(name, sizeof name, "t = %.2f s", snap_times_[k]);
-    left.series.push_back({"profiles.csv", "s", cols[1 + k], name, "lines"});
-    right.series.push_back({"profiles.csv", "s", cols[1 + snap_times_.size() + k], name, "lines"});
+    left.series.push_back({"profiles.csv", "s", cols[1 + k], name, "lines", 1e3});
+    right.series.push_back({"profiles.csv", "s", cols[1 + n + k], name, "lines", 1e3});
   }
+  left.y_range = right.y_range = {0, 1.05e3 * top};
   side.panels = {left, right};
   out.add_plot(side);
-  out.add_plot({"opening",
-                scene + ": largest gap width",
-                "time [s]",
-                "largest gap width [m]",
-                {{"metrics.csv", "t", "physics_max_opening", "physics", "lines"},
-                 {"metrics.csv", "t", "geometric_max_opening", geometric_short, "lines"}},
-                {}});
-  out.add_plot({"area",
-                scene + ": opened area",
-                "time [s]",
-                "opened area [m^2]",
-                {{"metrics.csv", "t", "physics_area", "physics", "lines"},
-                 {"metrics.csv", "t", "geometric_area", geometric_short, "lines"}},
-                {}});
+  Plot opening{
+      "opening",
+      labels.scene + ": largest gap width",
+      "time [s]",
+      "largest gap width [mm]",
+      {{"metrics.csv", "t", "physics_max_opening", "physics", "lines", 1e3},
+       {"metrics.csv", "t", "geometric_max_opening", labels.geometric_short, "lines", 1e3}}};
+  opening.events = events;
+  out.add_plot(std::move(opening));
+  Plot area{"area",
+            labels.scene + ": opened area",
+            "time [s]",
+            "opened area [mm²]",
+            {{"metrics.csv", "t", "physics_area", "physics", "lines", 1e6},
+             {"metrics.csv", "t", "geometric_area", labels.geometric_short, "lines", 1e6}}};
+  area.events = events;
+  out.add_plot(std::move(area));
 }
 
 }  // namespace conform::scenes

@@ -35,10 +35,15 @@ class OpeningProfiles {
   void snapshot(int step, double t, const Profile& physics, const Profile& geometric);
   /// profiles.csv: s, then one column per snapshot for each run.
   void write(RunOutput& out) const;
-  /// The plots; `scene` starts their titles, `geometric` names the geometric run in the
-  /// profile panel and `geometric_short` in the plots over time.
-  void add_plots(RunOutput& out, const std::string& scene, const std::string& physics,
-                 const std::string& geometric, const std::string& geometric_short) const;
+  /// What the plots call things: `scene` starts their titles, `physics` and `geometric` name
+  /// the runs in the profile plots, `geometric_short` in the plots over time.
+  struct Labels {
+    std::string scene, physics, geometric, geometric_short;
+  };
+  /// The plots, in mm: the final profiles of both runs overlaid with their ratio
+  /// (final_profiles), the profiles over time side by side on one scale (profiles), and the
+  /// largest gap and the opened area over time with the run's `events` marked (opening, area).
+  void add_plots(RunOutput& out, const Labels& labels, const std::vector<PlotEvent>& events) const;
 
  private:
   std::vector<std::string> columns() const;

@@ -231,9 +231,12 @@ class Character final : public Scene {
       add_comparison(*compare, body, bind, metrics);
       timings["geometric_copy_ms"] = compare->ms;
       compare->profiles.write(out);
-      compare->profiles.add_plots(out, "character", "physics (Bullet soft body)",
-                                  "geometric (skinned mesh, Algorithm 2 step 6)",
-                                  "geometric (step 6)");
+      compare->profiles.add_plots(
+          out,
+          {"character", "physics (Bullet soft body)",
+           "geometric (skinned mesh, Algorithm 2 step 6)", "geometric (step 6)"},
+          {{tear_.at, "stroke starts"},
+           {tear_.time(tear_.samples - 1), "stroke ends, geometric opened"}});
     }
     out.finish(resolved_, metrics, timings, c.steps, c.steps * c.dt, loop_s);
     return metrics;

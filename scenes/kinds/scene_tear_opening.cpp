@@ -149,8 +149,14 @@ class TearOpening final : public Scene {
     const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
     check_torn(r);
     r.profiles.write(out);
-    r.profiles.add_plots(out, "tear-opening", "physics (pre-stressed skin membrane in Bullet)",
-                         "geometric (Algorithm 2 step 6)", "geometric (step 6)");
+    std::vector<PlotEvent> events = {
+        {stroke_.at, "stroke starts"},
+        {stroke_.time(stroke_.samples - 1), "stroke ends, geometric opened"}};
+    if (flex_deg_ != 0) events.push_back({flex_at_, "elbow flexes"});
+    r.profiles.add_plots(out,
+                         {"tear-opening", "physics (pre-stressed skin membrane in Bullet)",
+                          "geometric (Algorithm 2 step 6)", "geometric (step 6)"},
+                         events);
     const Json metrics = summary(r);
     out.finish(resolved_, metrics, timings(r), c.steps, c.steps * c.dt, loop_s);
     return metrics;

@@ -48,6 +48,10 @@ void write_axes(std::ostream& gp, const Plot& p) {
      << "set ylabel " << text(p, p.ylabel) << "\n"
      << (p.log_y ? "set logscale y\nset format y '%g'\n"
                  : "unset logscale y\nset format y '% h'\n");
+  if (p.y_range.first < p.y_range.second)
+    gp << "set yrange [" << p.y_range.first << ":" << p.y_range.second << "]\n";
+  else
+    gp << "set yrange [*:*]\n";
   if (p.x_tics.empty()) {
     gp << "set xtics autofreq\n";
   } else {

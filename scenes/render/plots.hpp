@@ -52,6 +52,8 @@ struct Plot {
   /// Several panels side by side (multiplot), each with its own series; overrides `series`.
   std::vector<Plot> panels;
   bool log_y = false;
+  /// The y axis from first to second (both in the drawn unit, after y_scale); equal: autoscale.
+  std::pair<double, double> y_range{0, 0};
   /// The x tics, when x takes a few chosen values (a sweep's resolutions): one tic at each, so
   /// that whole numbers are not labelled 1.5; empty: gnuplot's own.
   std::vector<double> x_tics;
