@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <array>
 #include <assimp/Importer.hpp>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -144,8 +145,8 @@ TEST_F(SceneRender, PicturesHaveTheRequestedSizeAndShowTheWound) {
   ASSERT_EQ(rc_, 0);
   for (const char* step : {"000030", "000060"}) {
     const fs::path side = run_dir() / "pictures" / ("step_" + std::string(step) + ".png");
-    // Two panels, the colour bar's 170 px and the titles' 60 px.
-    EXPECT_EQ(png_size(side), (std::array<int, 2>{2 * kWidth + 170, kHeight + 60})) << side;
+    // Two panels, the colour bar's 170 px, the titles' 60 px and the captions' 34 px.
+    EXPECT_EQ(png_size(side), (std::array<int, 2>{2 * kWidth + 170, kHeight + 60 + 34})) << side;
     // f3d renders a frame's panels side by side in one strip (physics, then geometric).
     const fs::path strip =
         run_dir() / "pictures" / "panels" / ("strip_" + std::string(step) + ".png");
@@ -184,7 +185,7 @@ TEST_F(SceneRender, PicturesHaveTheRequestedSizeAndShowTheWound) {
 
 TEST_F(SceneRender, PictureHoldsTheStripAndAColourBar) {
   ASSERT_EQ(rc_, 0);
-  const int width = 2 * kWidth + 170, height = kHeight + 60;
+  const int width = 2 * kWidth + 170, height = kHeight + 60 + 34;
   const auto picture = pixels(run_dir() / "pictures/step_000060.png");
   const auto strip = pixels(run_dir() / "pictures/panels/strip_000060.png");
   ASSERT_EQ(picture.size(), std::size_t(3 * width * height));
@@ -215,6 +216,52 @@ TEST_F(SceneRender, PictureHoldsTheStripAndAColourBar) {
   for (int y = 0; y < 60; ++y)
     for (int x = 0; x < 2 * kWidth; ++x) ink += at(x, y)[0] < 100;
   EXPECT_GT(ink, 100);
+}
+
+// The scale bar is the length of its pixels at the camera's target: a panel's height spans
+// 2 d tan(a / 2) there (the camera of summary.json, through which the silhouettes below are
+// checked). It is the longest 1, 2 or 5 x 10^k that fits 130 px, drawn below the colour bar;
+// each panel's caption (its largest gap) is drawn below it.
+TEST_F(SceneRender, PictureHasAScaleBarAtTheWoundAndEachPanelsLargestGap) {
+  ASSERT_EQ(rc_, 0);
+  const Json s = Json::parse(read_text(run_dir() / "summary.json"), nullptr, false);
+  const Json& c = s["render"]["camera"];
+  double d2 = 0;
+  for (int i = 0; i < 3; ++i)
+    d2 += std::pow(c["position"][i].get<double>() - c["target"][i].get<double>(), 2);
+  const double mpp =
+      2 * std::sqrt(d2) * std::tan(0.5 * c["view_angle"].get<double>() * M_PI / 180) / kHeight;
+  const Json& bar = s["render"]["scale_bar"];
+  EXPECT_NEAR(bar["metres_per_pixel_at_target"].get<double>(), mpp, 1e-9 * mpp);
+  const double length = bar["length_m"];
+  const int px = bar["pixels"];
+  EXPECT_EQ(px, int(std::lround(length / mpp)));
+  EXPECT_LE(px, 130);
+  const double decade = std::pow(10.0, std::floor(std::log10(length) + 1e-9));
+  const double mantissa = length / decade;
+  EXPECT_TRUE(std::abs(mantissa - 1) < 1e-9 || std::abs(mantissa - 2) < 1e-9 ||
+              std::abs(mantissa - 5) < 1e-9)
+      << length;
+  const double next = mantissa < 1.5 ? 2 : mantissa < 3 ? 5 : 10;  // the next longer bar
+  EXPECT_GT(next * decade / mpp, 130.0);                           // does not fit
+  // In the picture: a black bar of that many pixels, 6 px below the panels, right of them.
+  const int width = 2 * kWidth + 170;
+  const auto picture = pixels(run_dir() / "pictures/step_000060.png");
+  ASSERT_EQ(picture.size(), std::size_t(3 * width * (kHeight + 60 + 34)));
+  const auto dark = [&](int x, int y) {
+    const std::size_t i = std::size_t(3 * (y * width + x));
+    return picture[i] < 80 && picture[i + 1] < 80 && picture[i + 2] < 80;
+  };
+  int run = 0;
+  for (int x = 2 * kWidth; x < width; ++x) run += dark(x, 60 + kHeight + 6);
+  EXPECT_NEAR(run, px + 1, 2);
+  // The captions: ink below each panel.
+  for (int panel = 0; panel < 2; ++panel) {
+    int ink = 0;
+    for (int y = 60 + kHeight; y < 60 + kHeight + 34; ++y)
+      for (int x = panel * kWidth; x < (panel + 1) * kWidth; ++x) ink += dark(x, y);
+    EXPECT_GT(ink, 50) << "panel " << panel;
+  }
 }
 
 // The silhouette IoU of panel k of `render` (a strip, or one panel's render) against an

@@ -21,6 +21,13 @@ Lips tear_lips(const mesh::Tear* tear) {
   return {tear->left_border(), tear->right_border()};
 }
 
+std::string gap_caption(const Profile& profile) {
+  if (profile.s.empty()) return "not torn yet";
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "largest gap %.2f mm", 1e3 * profile.max);
+  return buf;
+}
+
 OpeningProfiles::OpeningProfiles(int points, int snapshots, double from, int steps, double dt) {
   bins_.resize(static_cast<std::size_t>(points));
   for (int i = 0; i < points; ++i) bins_[static_cast<std::size_t>(i)] = double(i) / (points - 1);

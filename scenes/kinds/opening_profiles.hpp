@@ -20,6 +20,9 @@ namespace conform::scenes {
 Profile physical_profile(const bullet::SkinnedSoftBody& body);
 /// A tear's two borders, the wound the pictures aim at (none before the tear began).
 Lips tear_lips(const mesh::Tear* tear);
+/// A picture panel's caption: the profile's largest gap in mm ("largest gap 13.24 mm"), or
+/// "not torn yet".
+std::string gap_caption(const Profile& profile);
 
 class OpeningProfiles {
  public:

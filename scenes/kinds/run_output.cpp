@@ -123,9 +123,11 @@ void RunOutput::frame(const std::string& name, int step, const mesh::SkinnedMesh
 void RunOutput::picture(int step, const std::vector<PicturePanel>& panels) {
   if (!pictures_ && !gltf_) return;
   std::vector<FrameSnapshot> shots;
-  for (const auto& p : panels)
+  for (const auto& p : panels) {
     shots.push_back(
         snapshot(p.name, step, step * common_.dt, *p.mesh, p.lips, common_.render.scalar));
+    shots.back().caption = p.caption;
+  }
   if (gltf_)
     for (const auto& s : shots) gltf_->add(s);
   if (pictures_) pictures_->add(std::move(shots));

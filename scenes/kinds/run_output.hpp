@@ -55,6 +55,7 @@ struct PicturePanel {
   std::string name;
   const mesh::SkinnedMesh* mesh = nullptr;
   Lips lips{};
+  std::string caption;  // under the panel: its headline number ("largest gap 13.24 mm")
 };
 
 class RunOutput {

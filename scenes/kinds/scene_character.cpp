@@ -352,8 +352,10 @@ class Character final : public Scene {
     if (!compare) return;
     out.frame("geometric", step, compare->geo.mesh());
     // The physical panel is named as its frames, so run.glb keeps one sequence of the body.
-    out.picture(step, {{"character", &body.mesh(), tear_lips(body.tear())},
-                       {"geometric", &compare->geo.mesh(), tear_lips(&compare->geo.tear())}});
+    out.picture(step,
+                {{"character", &body.mesh(), tear_lips(body.tear()), gap_caption(compare->phys)},
+                 {"geometric", &compare->geo.mesh(), tear_lips(&compare->geo.tear()),
+                  gap_caption(compare->geom)}});
   }
 
   // metrics.physics and metrics.geometric: each opening at the end and its largest over the

@@ -141,8 +141,9 @@ class TearOpening final : public Scene {
         r.body.sync_mesh();
         out.frame("physics", step, r.body.mesh());
         out.frame("geometric", step, r.geo.mesh());
-        out.picture(step, {{"physics", &r.body.mesh(), tear_lips(r.body.tear())},
-                           {"geometric", &r.geo.mesh(), tear_lips(&r.geo.tear())}});
+        out.picture(step,
+                    {{"physics", &r.body.mesh(), tear_lips(r.body.tear()), gap_caption(r.phys)},
+                     {"geometric", &r.geo.mesh(), tear_lips(&r.geo.tear()), gap_caption(r.geom)}});
       }
       out.progress(step, c.steps);
     }

@@ -29,6 +29,7 @@ struct FrameSnapshot {
   std::vector<mesh::Face> faces;    // #F
   std::vector<double> scalar;       // #V
   std::vector<std::int32_t> focus;  // the event's vertices (both lips), may be empty
+  std::string caption;              // under the panel in the picture, e.g. its largest gap
 };
 
 /// The lips of a wound or cut, as vertex ids of the mesh.

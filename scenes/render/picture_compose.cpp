@@ -17,8 +17,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Margins: the title and the panel names above, the colour bar on the right.
-constexpr int kTop = 60, kRight = 170;
+// Margins: the title and the panel names above, the captions below, the colour bar and the
+// scale bar on the right.
+constexpr int kTop = 60, kBottom = 34, kRight = 170;
 constexpr double kTitlePt = 16, kNamePt = 14, kTickPt = 12;
 
 using Surface = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
@@ -91,8 +92,57 @@ void colour_bar(cairo_t* cr, double x0, int height, const ColourScale& scale) {
 }  // namespace
 
 PictureSize picture_size(int panels, int width, int height) {
-  return {panels * width + kRight, height + kTop};
+  return {panels * width + kRight, height + kTop + kBottom};
 }
+
+ScaleBar scale_bar(double metres_per_pixel, int max_pixels) {
+  ScaleBar bar{metres_per_pixel, 0, 0};
+  if (!(metres_per_pixel > 0) || !std::isfinite(metres_per_pixel) || max_pixels <= 0) return bar;
+  const double longest = metres_per_pixel * max_pixels;
+  const double decade = std::pow(10.0, std::floor(std::log10(longest)));
+  for (const double m : {5.0, 2.0, 1.0})
+    if (m * decade <= longest) {
+      bar.length_m = m * decade;
+      break;
+    }
+  bar.pixels = static_cast<int>(std::lround(bar.length_m / metres_per_pixel));
+  return bar;
+}
+
+namespace {
+
+// "20 mm", "0.5 mm", "2 m": a bar's length in the unit that reads best.
+std::string length_label(double metres) {
+  char buf[32];
+  if (metres >= 1)
+    std::snprintf(buf, sizeof buf, "%g m", metres);
+  else if (metres >= 1e-3)
+    std::snprintf(buf, sizeof buf, "%g mm", metres * 1e3);
+  else
+    std::snprintf(buf, sizeof buf, "%g µm", metres * 1e6);
+  return buf;
+}
+
+// The scale bar below the colour bar: a black bar with end ticks, its length above it, "at the
+// wound" below (a perspective picture has one scale at the target's depth only).
+void draw_scale_bar(cairo_t* cr, double x0, double y, const ScaleBar& bar) {
+  if (bar.pixels <= 0) return;
+  cairo_set_source_rgb(cr, 0, 0, 0);
+  cairo_set_line_width(cr, 3);
+  cairo_move_to(cr, x0, y);
+  cairo_line_to(cr, x0 + bar.pixels, y);
+  cairo_stroke(cr);
+  cairo_set_line_width(cr, 1);
+  for (const double x : {x0, x0 + bar.pixels}) {
+    cairo_move_to(cr, x, y - 5);
+    cairo_line_to(cr, x, y + 5);
+    cairo_stroke(cr);
+  }
+  text(cr, length_label(bar.length_m), x0 + 0.5 * bar.pixels, y - 8, kTickPt, 0.5, true);
+  text(cr, "at the wound", x0 + 0.5 * bar.pixels, y + 18, kTickPt, 0.5);
+}
+
+}  // namespace
 
 namespace {
 
@@ -136,8 +186,8 @@ Surface blank(int width, int height) {
 }  // namespace
 
 void compose_picture(const fs::path& out, const std::vector<fs::path>& renders,
-                     const std::vector<std::string>& names, int width, int height,
-                     const std::string& title, const ColourScale& scale) {
+                     const PictureText& words, int width, int height, const ColourScale& scale) {
+  const std::vector<std::string>& names = words.names;
   const int n = static_cast<int>(names.size());
   const PictureSize size = picture_size(n, width, height);
   const Surface canvas = blank(size.width, size.height);
@@ -159,8 +209,12 @@ void compose_picture(const fs::path& out, const std::vector<fs::path>& renders,
   cairo_set_source_rgb(cr.get(), 0, 0, 0);
   for (int i = 0; i < n; ++i)
     text(cr.get(), names[std::size_t(i)], (i + 0.5) * width, kTop - 8, kNamePt, 0.5);
-  text(cr.get(), title, 0.5 * n * width, 24, kTitlePt, 0.5, true);
+  for (std::size_t i = 0; i < words.captions.size() && i < names.size(); ++i)
+    text(cr.get(), words.captions[i], (double(i) + 0.5) * width, kTop + height + 22, kNamePt, 0.5,
+         true);
+  text(cr.get(), words.title, 0.5 * n * width, 24, kTitlePt, 0.5, true);
   colour_bar(cr.get(), n * width + 20, height, scale);
+  draw_scale_bar(cr.get(), n * width + 20, kTop + height + 6, words.bar);
   write_png(canvas.get(), out);
 }
 

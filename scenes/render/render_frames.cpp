@@ -4,11 +4,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
 #include <fstream>
 #include <iostream>
+#include <numbers>
 #include <sstream>
 #include <thread>
 
@@ -159,22 +161,40 @@ std::size_t jobs_count(const std::vector<std::vector<FrameSnapshot>>& frames, bo
   return n;
 }
 
+// The length of a pixel at the camera's target: a panel's height spans 2 d tan(a/2) there, d the
+// camera's distance and a its vertical view angle (a strip's camera, farther and narrower, frames
+// the target alike: strip_camera).
+double metres_per_pixel(const Camera& c, int height) {
+  const double d = (c.position - c.target).norm();
+  return 2 * d * std::tan(0.5 * c.view_angle * std::numbers::pi / 180) / height;
+}
+
 // The side-by-side pictures (picture_compose.hpp), one per chosen frame.
 bool compose(const fs::path& pics, const std::vector<std::vector<FrameSnapshot>>& frames,
-             const RenderSettings& r, const ColourScale& scale, const std::string& title,
-             Json& report) {
+             const RenderSettings& r, const ColourScale& scale, const Camera& camera,
+             const std::string& title, Json& report) {
   char buf[512];
+  PictureText words;
+  words.bar = scale_bar(metres_per_pixel(camera, r.height), kScaleBarPixels);
+  report["scale_bar"] = {{"metres_per_pixel_at_target", words.bar.metres_per_pixel},
+                         {"length_m", words.bar.length_m},
+                         {"pixels", words.bar.pixels}};
   try {
     for (const auto& frame : frames) {
       const int step = frame.front().step;
-      std::vector<std::string> names;
-      for (const auto& p : frame) names.push_back(p.name);
+      words.names.clear();
+      words.captions.clear();
+      for (const auto& p : frame) {
+        words.names.push_back(p.name);
+        words.captions.push_back(p.caption);
+      }
       std::snprintf(buf, sizeof buf, "%s, t = %.2f s, coloured by %s", title.c_str(),
                     frame.front().time, r.scalar.c_str());
+      words.title = buf;
       std::vector<fs::path> renders;
       for (const auto& name : renders_of(frame, r.perspective))
         renders.push_back(pics / (name + ".png"));
-      compose_picture(pics / (stem("step", step) + ".png"), renders, names, r.width, r.height, buf,
+      compose_picture(pics / (stem("step", step) + ".png"), renders, words, r.width, r.height,
                       scale);
     }
   } catch (const std::exception& e) {
@@ -439,7 +459,7 @@ Json PictureRenderer::finish() {
     return report;
   }
   const auto t_compose = Clock::now();
-  if (compose(p.pics, p.frames, settings_, p.scale, title_, report))
+  if (compose(p.pics, p.frames, settings_, p.scale, p.camera, title_, report))
     for (const auto& f : p.frames)
       report["pictures"].push_back("pictures/" + stem("step", f.front().step) + ".png");
   const double compose_ms = ms_since(t_compose);
