@@ -24,12 +24,11 @@
 #include <string>
 #include <vector>
 
-#include "conform/bullet/convert.hpp"
-#include "conform/bullet/plugin.hpp"
-#include "conform/bullet/rigid_scalpel.hpp"
-#include "conform/ik/arm_ik.hpp"
-#include "conform/io/import.hpp"
-#include "conform/skin/procedural_arm.hpp"
+// Through the libraries' one-include headers, as an application would start.
+#include "conform/bullet.hpp"
+#include "conform/ik.hpp"
+#include "conform/io.hpp"
+#include "conform/skin.hpp"
 
 namespace cb = conform::bullet;
 
