@@ -98,6 +98,12 @@ TEST(SceneCharacterCompare, BothOpeningsInMetresWithProfilesAndPictures) {
   if (std::system("command -v f3d > /dev/null 2>&1") == 0) {
     EXPECT_TRUE(fs::exists(r.dir / "pictures" / "step_000060.png")) << r.summary["render"].dump();
     EXPECT_TRUE(fs::exists(r.dir / "pictures" / "panels" / "strip_000060.png"));
+    // Coloured by the gap across the lips, in metres: at most the model's size (an edge strain
+    // against the mesh-space rest positions read +-119 on this model).
+    const Json& scale = r.summary["render"]["scale"];
+    EXPECT_EQ(scale["scalar"], "gap");
+    EXPECT_GT(scale["max"].get<double>(), 0.0);
+    EXPECT_LT(scale["max"].get<double>(), diagonal);
   }
 }
 
