@@ -19,10 +19,12 @@ if(GIT_FOUND)
     # Only the project's own repository: a source tree unpacked inside another one is not it.
     if(top STREQUAL src)
       set(CONFORM_GIT_COMMIT "${commit}")
-      execute_process(COMMAND ${GIT_EXECUTABLE} -C ${SOURCE_DIR} status --porcelain
-                              --untracked-files=no
-                      OUTPUT_VARIABLE changes ERROR_QUIET OUTPUT_STRIP_TRAILING_WHITESPACE)
-      if(NOT changes STREQUAL "")
+      # --no-optional-locks: a build never holds index.lock while the user runs git.
+      execute_process(COMMAND ${GIT_EXECUTABLE} --no-optional-locks -C ${SOURCE_DIR} status
+                              --porcelain --untracked-files=no
+                      OUTPUT_VARIABLE changes RESULT_VARIABLE status_rc ERROR_QUIET
+                      OUTPUT_STRIP_TRAILING_WHITESPACE)
+      if(NOT status_rc EQUAL 0 OR NOT changes STREQUAL "")
         set(CONFORM_GIT_DIRTY "true")
       endif()
     endif()

@@ -3,6 +3,7 @@
 // quantity that is 0 throughout is a sentence in summary.json, not a flat plot; lengths are in
 // millimetres; and the two tracking errors of arm-track are told apart on a log scale.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -19,14 +20,22 @@ namespace {
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
 
+// `conform run SCENE ARGS` into a folder of this test's own (ctest runs the tests of this file
+// in parallel processes).
 fs::path run(const std::string& scene, const std::string& args) {
-  const fs::path out = fs::path(testing::TempDir()) / ("conform_plots_" + scene);
+  const std::string test = testing::UnitTest::GetInstance()->current_test_info()->name();
+  const fs::path out =
+      fs::path(testing::TempDir()) / ("conform_plots_" + test + "_" + std::to_string(::getpid()));
   fs::remove_all(out);
   const std::string cmd = (fs::path(CONFORM_BINARY_DIR) / "scenes" / "conform").string() + " run " +
                           scene + " --no-render " + args + " --out " + out.string() + " > " +
                           out.string() + ".log 2>&1";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
   return out;
+}
+
+bool have_gnuplot() {
+  return std::system("command -v gnuplot > /dev/null 2>&1") == 0;
 }
 
 std::string read(const fs::path& file) {
@@ -66,6 +75,7 @@ Table read_csv(const fs::path& file) {
 }
 
 TEST(ScenePlots, TheHandPieceIsBlankBeforeTheCutWhichThePlotMarks) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed (scripts/deps.sh installs it)";
   const fs::path out = run("cut", "--steps 45");
   const Json summary = Json::parse(read(out / "summary.json"));
   const double cut_at = summary["settings"]["cut"]["at"];
@@ -99,6 +109,7 @@ TEST(ScenePlots, TheHandPieceIsBlankBeforeTheCutWhichThePlotMarks) {
 // On the default character (Debian's huesitos.fbx) the seams never open: its seam_gap plot
 // would be a flat 0.
 TEST(ScenePlots, AQuantityThatIsZeroThroughoutIsASentenceNotAPlot) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed (scripts/deps.sh installs it)";
   const fs::path out = run("character", "--steps 80");
   const Table t = read_csv(out / "metrics.csv");
   const std::size_t gap = t.column("seam_gap_rel");
@@ -120,6 +131,7 @@ TEST(ScenePlots, AQuantityThatIsZeroThroughoutIsASentenceNotAPlot) {
 // axis in mm, titled with their ratio; the opening over time marks the stroke's start and end
 // (where the geometric opening steps up).
 TEST(ScenePlots, FinalProfilesOverlaidWithTheirRatioAndTheStrokeMarked) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed (scripts/deps.sh installs it)";
   const fs::path out = run("character", "--steps 90");
   const Json summary = Json::parse(read(out / "summary.json"));
   const Json& tear = summary["settings"]["tear"];
@@ -152,6 +164,7 @@ TEST(ScenePlots, FinalProfilesOverlaidWithTheirRatioAndTheStrokeMarked) {
 }
 
 TEST(ScenePlots, ArmTrackErrorsAreOnALogScaleInMillimetres) {
+  if (!have_gnuplot()) GTEST_SKIP() << "gnuplot is not installed (scripts/deps.sh installs it)";
   const fs::path out = run("arm-track", "--steps 30");
   const std::string gp = read(out / "tracking_error.gp");
   EXPECT_NE(gp.find("set logscale y"), std::string::npos) << gp;

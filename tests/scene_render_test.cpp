@@ -244,7 +244,7 @@ TEST_F(SceneRender, PictureHasAScaleBarAtTheWoundAndEachPanelsLargestGap) {
       << length;
   const double next = mantissa < 1.5 ? 2 : mantissa < 3 ? 5 : 10;  // the next longer bar
   EXPECT_GT(next * decade / mpp, 130.0);                           // does not fit
-  // In the picture: a black bar of that many pixels, 6 px below the panels, right of them.
+  // In the picture: a black bar of that many pixels, 10 px below the panels, right of them.
   const int width = 2 * kWidth + 170;
   const auto picture = pixels(run_dir() / "pictures/step_000060.png");
   ASSERT_EQ(picture.size(), std::size_t(3 * width * (kHeight + 60 + 34)));
@@ -253,7 +253,7 @@ TEST_F(SceneRender, PictureHasAScaleBarAtTheWoundAndEachPanelsLargestGap) {
     return picture[i] < 80 && picture[i + 1] < 80 && picture[i + 2] < 80;
   };
   int run = 0;
-  for (int x = 2 * kWidth; x < width; ++x) run += dark(x, 60 + kHeight + 6);
+  for (int x = 2 * kWidth; x < width; ++x) run += dark(x, 60 + kHeight + 10);
   EXPECT_NEAR(run, px + 1, 2);
   // The captions: ink below each panel.
   for (int panel = 0; panel < 2; ++panel) {

@@ -37,6 +37,9 @@ OpeningProfiles::OpeningProfiles(int points, int snapshots, double from, int ste
     const double t = from + (end_time - from) * u * u;
     snapshot_steps_.push_back(std::clamp(static_cast<int>(std::lround(t / dt)), 1, steps));
   }
+  // A short run can round two snapshots to one step: it is kept once (one column per step).
+  snapshot_steps_.erase(std::unique(snapshot_steps_.begin(), snapshot_steps_.end()),
+                        snapshot_steps_.end());
 }
 
 void OpeningProfiles::open_history(RunOutput& out) {

@@ -12,7 +12,7 @@ namespace conform::scenes {
 /// The commit the scenes were built from (generated at build time by cmake/build_info.cmake).
 struct BuildInfo {
   std::string git_commit;  ///< "unknown" when built outside the project's git checkout
-  bool git_dirty = false;  ///< tracked files differed from the commit when it was built
+  bool git_dirty = false;  ///< tracked files differed from the commit (or git could not tell)
   std::string build_type;  ///< CMake's build type, e.g. "Release"
 };
 BuildInfo build_info();

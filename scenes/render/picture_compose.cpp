@@ -99,7 +99,9 @@ ScaleBar scale_bar(double metres_per_pixel, int max_pixels) {
   ScaleBar bar{metres_per_pixel, 0, 0};
   if (!(metres_per_pixel > 0) || !std::isfinite(metres_per_pixel) || max_pixels <= 0) return bar;
   const double longest = metres_per_pixel * max_pixels;
+  if (!std::isfinite(longest)) return bar;
   const double decade = std::pow(10.0, std::floor(std::log10(longest)));
+  bar.length_m = decade / 10;  // log10's rounding may put `longest` just under `decade`
   for (const double m : {5.0, 2.0, 1.0})
     if (m * decade <= longest) {
       bar.length_m = m * decade;
@@ -123,8 +125,8 @@ std::string length_label(double metres) {
   return buf;
 }
 
-// The scale bar below the colour bar: a black bar with end ticks, its length above it, "at the
-// wound" below (a perspective picture has one scale at the target's depth only).
+// The scale bar below the colour bar and the wound bed's swatch: a black bar with end ticks, and
+// below it its length "at the wound" (a perspective picture has one scale, at the target's depth).
 void draw_scale_bar(cairo_t* cr, double x0, double y, const ScaleBar& bar) {
   if (bar.pixels <= 0) return;
   cairo_set_source_rgb(cr, 0, 0, 0);
@@ -138,8 +140,7 @@ void draw_scale_bar(cairo_t* cr, double x0, double y, const ScaleBar& bar) {
     cairo_line_to(cr, x, y + 5);
     cairo_stroke(cr);
   }
-  text(cr, length_label(bar.length_m), x0 + 0.5 * bar.pixels, y - 8, kTickPt, 0.5, true);
-  text(cr, "at the wound", x0 + 0.5 * bar.pixels, y + 18, kTickPt, 0.5);
+  text(cr, length_label(bar.length_m) + " at the wound", x0, y + 18, kTickPt, 0);
 }
 
 }  // namespace
@@ -214,7 +215,7 @@ void compose_picture(const fs::path& out, const std::vector<fs::path>& renders,
          true);
   text(cr.get(), words.title, 0.5 * n * width, 24, kTitlePt, 0.5, true);
   colour_bar(cr.get(), n * width + 20, height, scale);
-  draw_scale_bar(cr.get(), n * width + 20, kTop + height + 6, words.bar);
+  draw_scale_bar(cr.get(), n * width + 20, kTop + height + 10, words.bar);
   write_png(canvas.get(), out);
 }
 

@@ -102,8 +102,8 @@ bool write_plot_script(const fs::path& dir, const Plot& plot, std::string& probl
   return bool(gp);
 }
 
-// Whether column `name` of the CSV file holds only 0 and empty fields; false when the file or
-// the column cannot be read.
+// Whether column `name` of the CSV file (written by RunOutput::Csv: numbers or empty fields)
+// holds only 0 and empty fields; false when the file or the column cannot be read.
 bool column_is_zero(const fs::path& file, const std::string& name) {
   std::ifstream in(file);
   std::string line, field;
