@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include <sys/wait.h>
+#include "conform_run.hpp"
 
 namespace {
 
@@ -22,32 +22,11 @@ using Json = nlohmann::json;
 const std::string kHuesitos = "/usr/share/assimp/models/FBX/huesitos.fbx";
 const std::string kShort = " --steps 60 --set drill.enabled=false --set outputs.plots=false ";
 
-struct Outcome {
-  int rc = -1;
-  std::string log;
-  Json summary;
-  fs::path dir;
-};
+using Outcome = conform::test::CommandRun;
 
 // `conform run character ARGS` into a fresh folder.
 Outcome run(const std::string& args, const std::string& tag) {
-  const fs::path conform = fs::path(CONFORM_BINARY_DIR) / "scenes" / "conform";
-  Outcome r;
-  if (!fs::exists(conform)) {
-    ADD_FAILURE() << "build the conform command first: " << conform;
-    return r;
-  }
-  r.dir = fs::path(testing::TempDir()) / ("conform_character_compare_" + tag);
-  fs::remove_all(r.dir);
-  const std::string cmd = conform.string() + " run character --out " + r.dir.string() + kShort +
-                          args + " > " + r.dir.string() + ".log 2>&1";
-  const int status = std::system(cmd.c_str());
-  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream log(r.dir.string() + ".log");
-  r.log.assign(std::istreambuf_iterator<char>(log), {});
-  std::ifstream in(r.dir / "summary.json");
-  if (in) r.summary = Json::parse(in, nullptr, false);
-  return r;
+  return conform::test::run_conform_scene("character", kShort + args, "character_compare_" + tag);
 }
 
 // The first line of a CSV file (its columns), "" when it cannot be read.

@@ -11,7 +11,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include <sys/wait.h>
+#include "conform_run.hpp"
 
 namespace {
 
@@ -23,31 +23,12 @@ const std::string kModels = "/usr/share/assimp/models/";
 const std::string kNoEdits =
     " --set cut.enabled=false --set tear.enabled=false --set drill.enabled=false ";
 
-struct Outcome {
-  int rc = -1;
-  std::string log;
-  Json summary;
-};
+using Outcome = conform::test::CommandRun;
 
 // `conform run character ARGS` into a fresh folder.
 Outcome run(const std::string& args, const std::string& tag) {
-  const fs::path conform = fs::path(CONFORM_BINARY_DIR) / "scenes" / "conform";
-  Outcome r;
-  if (!fs::exists(conform)) {
-    ADD_FAILURE() << "build the conform command first: " << conform;
-    return r;
-  }
-  const fs::path dir = fs::path(testing::TempDir()) / ("conform_character_" + tag);
-  fs::remove_all(dir);
-  const std::string cmd = conform.string() + " run character --no-render --out " + dir.string() +
-                          " --set outputs.plots=false " + args + " > " + dir.string() + ".log 2>&1";
-  const int status = std::system(cmd.c_str());
-  r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream log(dir.string() + ".log");
-  r.log.assign(std::istreambuf_iterator<char>(log), {});
-  std::ifstream in(dir / "summary.json");
-  if (in) r.summary = Json::parse(in, nullptr, false);
-  return r;
+  return conform::test::run_conform_scene(
+      "character", "--no-render --set outputs.plots=false " + args, "character_" + tag);
 }
 
 // simple_skin.gltf with its scene under a node scaled by `scale`: the file's coordinates (its

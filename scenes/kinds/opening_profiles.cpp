@@ -21,6 +21,18 @@ Lips tear_lips(const mesh::Tear* tear) {
   return {tear->left_border(), tear->right_border()};
 }
 
+ComparisonKeys read_comparison_keys(Reader& root) {
+  ComparisonKeys k;
+  Reader geo = root.object("geometric");
+  k.amount = geo.number("amount", k.amount, 0, 1);
+  geo.finish();
+  Reader prof = root.object("profiles");
+  k.snapshots = prof.integer("snapshots", k.snapshots, 1, 100);
+  k.points = prof.integer("points", k.points, 3, 10000);
+  prof.finish();
+  return k;
+}
+
 std::string gap_caption(const Profile& profile) {
   if (profile.s.empty()) return "not torn yet";
   char buf[48];
@@ -115,6 +127,21 @@ Plot final_overlay(const std::string& scene, const std::string& physics_column,
            {"profiles.csv", "s", geometric_column, geometric, "lines", 1e3}}};
 }
 
+// metrics.csv's physics_QUANTITY and geometric_QUANTITY over time, scaled (to mm, mm²), with the
+// run's events marked.
+Plot over_time(const std::string& name, const std::string& title, const std::string& ylabel,
+               const std::string& quantity, double scale, const std::string& geometric,
+               const std::vector<PlotEvent>& events) {
+  Plot p{name,
+         title,
+         "time [s]",
+         ylabel,
+         {{"metrics.csv", "t", "physics_" + quantity, "physics", "lines", scale},
+          {"metrics.csv", "t", "geometric_" + quantity, geometric, "lines", scale}}};
+  p.events = events;
+  return p;
+}
+
 }  // namespace
 
 void OpeningProfiles::add_plots(RunOutput& out, const Labels& labels,
@@ -142,23 +169,11 @@ void OpeningProfiles::add_plots(RunOutput& out, const Labels& labels,
   left.y_range = right.y_range = {0, 1.05e3 * top};
   side.panels = {left, right};
   out.add_plot(side);
-  Plot opening{
-      "opening",
-      labels.scene + ": largest gap width",
-      "time [s]",
-      "largest gap width [mm]",
-      {{"metrics.csv", "t", "physics_max_opening", "physics", "lines", 1e3},
-       {"metrics.csv", "t", "geometric_max_opening", labels.geometric_short, "lines", 1e3}}};
-  opening.events = events;
-  out.add_plot(std::move(opening));
-  Plot area{"area",
-            labels.scene + ": opened area",
-            "time [s]",
-            "opened area [mm²]",
-            {{"metrics.csv", "t", "physics_area", "physics", "lines", 1e6},
-             {"metrics.csv", "t", "geometric_area", labels.geometric_short, "lines", 1e6}}};
-  area.events = events;
-  out.add_plot(std::move(area));
+  const std::string& geo = labels.geometric_short;
+  out.add_plot(over_time("opening", labels.scene + ": largest gap width", "largest gap width [mm]",
+                         "max_opening", 1e3, geo, events));
+  out.add_plot(over_time("area", labels.scene + ": opened area", "opened area [mm²]", "area", 1e6,
+                         geo, events));
 }
 
 }  // namespace conform::scenes

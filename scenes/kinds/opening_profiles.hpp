@@ -20,6 +20,14 @@ namespace conform::scenes {
 Profile physical_profile(const bullet::SkinnedSoftBody& body);
 /// A tear's two borders, the wound the pictures aim at (none before the tear began).
 Lips tear_lips(const mesh::Tear* tear);
+/// The keys of a scene that compares its tear with a geometric copy: geometric.amount (how far
+/// the copy is opened, in the scene's own unit), profiles.snapshots and profiles.points.
+struct ComparisonKeys {
+  double amount = 0.01;
+  int snapshots = 6, points = 41;
+};
+ComparisonKeys read_comparison_keys(Reader& root);
+
 /// A picture panel's caption: the profile's largest gap in mm ("largest gap 13.24 mm"), or
 /// "not torn yet".
 std::string gap_caption(const Profile& profile);

@@ -150,13 +150,7 @@ class Character final : public Scene {
     drill_ = read_drill(root);
     // The geometric copy's opening, a fraction of the bind pose's diagonal (as every length
     // placed on the model), and the profiles kept of both openings (tear-opening's keys).
-    Reader geo = root.object("geometric");
-    amount_ = geo.number("amount", 0.01, 0, 1);
-    geo.finish();
-    Reader prof = root.object("profiles");
-    snapshots_ = prof.integer("snapshots", 6, 1, 100);
-    points_ = prof.integer("points", 41, 3, 10000);
-    prof.finish();
+    compare_ = read_comparison_keys(root);
     common_ = read_common(root, name, 3.0, steps_override);
     root.finish();
   }
@@ -191,7 +185,8 @@ class Character final : public Scene {
     TearRun tear(tear_, bind);
     std::optional<TearCompare> compare;
     if (tear_.enabled)
-      compare.emplace(model.mesh, OpeningProfiles(points_, snapshots_, tear_.at, c.steps, c.dt));
+      compare.emplace(model.mesh, OpeningProfiles(compare_.points, compare_.snapshots, tear_.at,
+                                                  c.steps, c.dt));
     std::vector<Eigen::Vector3d> start_targets(static_cast<std::size_t>(body.vertex_count()));
     for (std::int32_t v = 0; v < body.vertex_count(); ++v)
       start_targets[static_cast<std::size_t>(v)] = body.target(v);
@@ -320,7 +315,7 @@ class Character final : public Scene {
     compare->geo.repose(body.skeleton(), body.pose(), body.world_transform());
     compare->ms += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
     if (!tear.done()) tear.advance(body, t, &compare->geo);
-    if (tear.done() && !compare->geo.opened()) compare->geo.open(amount_ * bind.diagonal());
+    if (tear.done() && !compare->geo.opened()) compare->geo.open(compare_.amount * bind.diagonal());
   }
 
   void measure(const bullet::SkinnedSoftBody& body, const SeamGap& seams, const BindPose& bind,
@@ -371,8 +366,8 @@ class Character final : public Scene {
     };
     m["physics"] = part(k.phys, k.max_phys, body.tear());
     m["geometric"] = part(k.geom, k.max_geom, &k.geo.tear());
-    m["geometric"]["amount"] = amount_;                      // of the bind pose's diagonal
-    m["geometric"]["amount_m"] = amount_ * bind.diagonal();  // metres
+    m["geometric"]["amount"] = compare_.amount;  // of the bind pose's diagonal
+    m["geometric"]["amount_m"] = compare_.amount * bind.diagonal();  // metres
     m["physics_over_geometric_max_opening"] = k.geom.max > 0 ? k.phys.max / k.geom.max : 0.0;
     m["opening_units"] = "metres, square metres; profile_r2 of w_max*sqrt(1-(2s-1)^2)";
   }
@@ -451,8 +446,7 @@ class Character final : public Scene {
   CutEdit cut_;
   TearEdit tear_;
   DrillEdit drill_;
-  double amount_ = 0.01;  // geometric.amount, of the bind pose's diagonal
-  int snapshots_ = 6, points_ = 41;
+  ComparisonKeys compare_;  // geometric.amount is a fraction of the bind pose's diagonal
 };
 
 std::unique_ptr<Scene> make_character(const Json& scene, const std::string& name, int steps) {

@@ -104,13 +104,7 @@ class TearOpening final : public Scene {
       stroke_.to = centre + half * Vec3::UnitY();
     }
     tear.finish();
-    Reader geo = root.object("geometric");
-    amount_ = geo.number("amount", 0.01, 0, 1);
-    geo.finish();
-    Reader prof = root.object("profiles");
-    snapshots_ = prof.integer("snapshots", 6, 1, 100);
-    bins_ = prof.integer("points", 41, 3, 10000);
-    prof.finish();
+    compare_ = read_comparison_keys(root);  // geometric.amount in metres
     common_ = read_common(root, name, 3.0, steps_override);
     root.finish();
   }
@@ -122,7 +116,7 @@ class TearOpening final : public Scene {
     if (flex_deg_ != 0) require_before_end(c, "pose.flex_at", flex_at_, "the flex", flex_at_);
     skin::Pose pose;
     TearRun r(posed_arm(pose), pose, c, material_,
-              OpeningProfiles(bins_, snapshots_, stroke_.at, c.steps, c.dt));
+              OpeningProfiles(compare_.points, compare_.snapshots, stroke_.at, c.steps, c.dt));
     r.body.set_pose_source(flexing_pose(pose));
     out.open_metrics({"t", "physics_tear_points", "geometric_tear_points", "physics_max_opening",
                       "geometric_max_opening", "physics_area", "geometric_area",
@@ -261,7 +255,7 @@ class TearOpening final : public Scene {
       r.geo.advance(sample);
       ++r.next, ++r.tear_steps;
     }
-    if (r.next == stroke_.samples && !r.geo.opened()) r.geo.open(amount_);
+    if (r.next == stroke_.samples && !r.geo.opened()) r.geo.open(compare_.amount);
   }
 
   // Both profiles now; a metrics row, the profile history and the snapshots when due.
@@ -323,7 +317,7 @@ class TearOpening final : public Scene {
     Json metrics;
     metrics["physics"] = part(r.phys, r.max_phys, *r.body.tear());
     metrics["geometric"] = part(r.geom, r.max_geom, r.geo.tear());
-    metrics["geometric"]["amount"] = amount_;
+    metrics["geometric"]["amount"] = compare_.amount;
     const membrane::SolveReport& solve = r.body.last_solve();
     metrics["physics"]["residual"] = solve.residual;                    // Pa, the last substep's
     metrics["physics"]["relative_residual"] = solve.relative_residual;  // over the pre-stress
@@ -357,8 +351,7 @@ class TearOpening final : public Scene {
   bool across_ = false;
   bullet::Material material_;
   Stroke stroke_;
-  double amount_ = 0.01;
-  int snapshots_ = 6, bins_ = 41;
+  ComparisonKeys compare_;
 };
 
 std::unique_ptr<Scene> make_tear_opening(const Json& scene, const std::string& name,
