@@ -70,6 +70,7 @@ struct SkinnedSoftBody::Impl::Piece {
   PieceSettings settings;    // inherited by the pieces split from it
   bool released = false;     // released from skinning (release_piece): not driven
   ReleaseOptions release{};  // how, when released
+  double release_volume = 0;  // V0, m³: the closed piece's volume at release (0: open)
 };
 
 /// One whole connected piece on its way into a new body (move_to_new_piece and its steps).

@@ -1,7 +1,7 @@
 // Releasing a piece from skinning: its nodes leave the skin drive (no target, no membrane, not
 // kinematic) and become an ordinary Bullet soft body that falls and collides, its shape held by
-// Bullet's own links at the lengths it has when released and, for a closed piece, by Bullet's
-// volume constraint (kVC) or pressure (kPR).
+// Bullet's own links at the lengths it has when released and, for a closed piece, by the
+// plugin's implicit volume step (released_volume.cpp), not Bullet's explicit kVC and kPR.
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -73,15 +73,14 @@ void SkinnedSoftBody::Impl::refresh_released() {
     btSoftBody& body = *piece->body;
     if (body.m_pose.m_wgh.size() == body.m_nodes.size()) continue;  // nodes unchanged
     release_nodes(*piece);
-    // Bullet's volume and pressure forces (applyForces) read m_pose.m_volume and kVC, kPR;
-    // m_wgh's size records the node count the volume was taken at (pose matching, which
-    // reads it, is off: m_bframe false).
+    // The volume force is ours (hold_released_volumes, implicit): Bullet's own (kVC, kPR) is
+    // explicit and blows up above a modulus set by the step. m_wgh's size records the node
+    // count the volume was taken at (pose matching, which reads it, is off: m_bframe false).
     const double volume = double(body.getVolume());
-    const bool closed = volume > 0;
-    body.m_pose.m_bvolume = closed && piece->release.volume_modulus > 0;
-    body.m_pose.m_volume = btScalar(closed ? volume : 0);
-    body.m_cfg.kVC = btScalar(closed ? piece->release.volume_modulus / volume : 0);
-    body.m_cfg.kPR = btScalar(closed ? piece->release.pressure * volume : 0);
+    piece->release_volume = volume > 0 ? volume : 0;
+    body.m_pose.m_bvolume = false;
+    body.m_cfg.kVC = 0;
+    body.m_cfg.kPR = 0;
     body.m_pose.m_wgh.resize(body.m_nodes.size(), btScalar(0));
   }
 }

@@ -137,6 +137,7 @@ void SkinnedSoftBody::Impl::update(double dt, double time) {
     const Eigen::Vector3d t = drive_.target(std::int32_t(v)), tp = drive_.previous_target(v);
     detached_state_[slot] = {t, (t - tp) / dt};
   }
+  hold_released_volumes(dt);
   if (membrane_model()) {
     step_membrane(dt);
     return;

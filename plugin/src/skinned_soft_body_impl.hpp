@@ -137,6 +137,8 @@ struct SkinnedSoftBody::Impl {
   /// After an edit: released pieces' new nodes are free too, and a volume-keeping piece whose
   /// nodes changed keeps the volume it has now.
   void refresh_released();
+  /// Each substep: the released, closed pieces' volume force, implicit (released_volume.cpp).
+  void hold_released_volumes(double dt);
 
   // --- Skin drive (skin_drive.cpp): update() is the one per-substep entry point ---
   void update(double dt, double time);
@@ -229,6 +231,7 @@ struct SkinnedSoftBody::Impl {
   MembraneDrive membrane_;
   std::vector<void*> vertex_node_;  // per vertex: its btSoftBody::Node (null when detached)
   Eigen::Matrix3Xd target_matrix_, previous_matrix_;
+  std::vector<btVector3> volume_gradient_;  // hold_released_volumes' ∂V/∂x_i, reused
 
   // Per vertex.
   std::vector<std::int32_t> piece_of_, node_of_;

@@ -71,14 +71,16 @@ struct ReleaseOptions {
   /// kLST of the piece's links, in (0, 1]: their rest lengths become the lengths at release.
   double link_stiffness = 0.9;
   /// Keeps the volume the piece has at release: a bulk modulus K in Pa (>= 0; 0 = off), the
-  /// pressure K (V0 − V) / V0 pushing the faces out along their normals. Bullet's volume force
-  /// is kVC (V0 − V) per unit of node area, so kVC = K / V0: Bullet's raw kVC is not
-  /// scale-free (a 5 cm piece needs kVC ~ 1e5 to hold against its weight). Needs a closed
-  /// piece (e.g. a capped cut); K well above areal density × g (about 11 Pa for skin) keeps it
-  /// from crushing under its own weight.
+  /// pressure K (V0 − V) / V0 pushing on the closed surface. The plugin integrates it
+  /// implicitly, interleaved with the links' lengths, so every K is stable at any step (Bullet's
+  /// own explicit kVC blew a 5 cm piece up from 300 Pa on at 1/60 s). Needs a closed piece
+  /// (e.g. a capped cut). Measured on a capped forearm dropped 16 cm on a box: from 1000 Pa on,
+  /// 93-97 % of the volume is kept at rest with 4 substeps of 1/240 s; with one step of 1/60 s
+  /// the impact (1.8 m/s, 3 cm in one step) crumples it to about 71 %. Below about 100 Pa
+  /// (9 × the skin's weight per area, 1.1 kg/m² × g) it sags under its own weight.
   double volume_modulus = 0.0;
   /// An inner pressure in Pa at the release volume (>= 0; 0 = off), following Boyle's law
-  /// (Bullet's kPR = p V0, its pressure being kPR / V). Needs a closed piece.
+  /// (p V = p0 V0), integrated implicitly as the modulus is. Needs a closed piece.
   double pressure = 0.0;
 };
 
