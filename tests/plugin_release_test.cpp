@@ -207,6 +207,20 @@ TEST(PluginRelease, WithoutItsVolumeAHollowPieceCrushesFlat) {
   EXPECT_LT(l.volume_after, 0.2 * l.volume_before);  // a paper bag: edge lengths, no volume
 }
 
+// An inner pressure alone (Boyle's law, p V = p0 V0) holds the piece up too: p0 = 100 Pa is
+// about 9 × the skin's weight per area, so the piece keeps its volume, where without it it is
+// crushed flat (above). At 1000 Pa it pushed its own bottom through the box (see piece.hpp).
+TEST(PluginRelease, AnInnerPressureHoldsThePieceUp) {
+  bullet::ReleaseOptions release{};
+  release.pressure = 100;
+  const Landing l = land(kVoxel, release, kFrames, false, kSubsteps, kMargin);
+  print("voxel 0.025 m, 4 substeps, margin 1 cm, pressure 100 Pa", l);
+  EXPECT_LT(l.worst_inside, 1e-3);
+  EXPECT_LT(l.com_speed, 0.05);
+  EXPECT_GT(l.volume_after, 0.9 * l.volume_before);
+  EXPECT_GT(l.min_y, kBoxCentre.y() + kBoxHalf.y() - 1e-3);  // on the box, not through it
+}
+
 TEST(PluginRelease, BulletsDefaultVoxelAndAPlaneGroundDoNotHold) {
   // Figures for the README (printed); the assertions pin the direction of each finding.
   bullet::ReleaseOptions keep{};

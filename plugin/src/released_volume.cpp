@@ -63,9 +63,11 @@ void SkinnedSoftBody::Impl::hold_released_volumes(double dt) {
     btSoftBody& body = *piece->body;
     // The compliant constraint C = V − V0 (compliance V0 / (K dt²)), interleaved with the
     // links, multiplier λ accumulated over the passes; its first pass is the formula above.
+    // At least 8 passes: a capped hand dropped on the ground at 1e5 Pa kept 85 % of its volume
+    // with one pass, 91 % with 8 (the rest goes to Bullet's own solve of links and contacts).
     const double compliance = modulus > 0 ? v0 / (modulus * dt * dt) : 0;
     double lambda = 0;
-    for (int pass = 0; pass < std::max(1, body.m_cfg.piterations); ++pass) {
+    for (int pass = 0; pass < std::max(8, body.m_cfg.piterations); ++pass) {
       const double v = volume_and_gradient(body, volume_gradient_);
       if (!(v > 0)) break;  // turned inside out: no pressure to speak of (the check reports NaN)
       double s = 0;         // Σ |g_j|² / m_j

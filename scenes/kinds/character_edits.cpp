@@ -89,6 +89,7 @@ CutEdit read_cut(Reader& root) {
   if (!(e.normal.norm() > 1e-9)) r.fail("normal", Json{0, 0, 0}, "must not be zero");
   e.cap = r.boolean("cap", d.cap);
   read_region(r, e);
+  e.sever = read_sever(r, d.sever);
   r.finish();
   return e;
 }

@@ -24,6 +24,7 @@
 
 #include "base/scene_config.hpp"
 #include "conform/bullet/skinned_soft_body.hpp"
+#include "kinds/falling_pieces.hpp"
 #include "kinds/geometric_tear.hpp"
 
 namespace conform::scenes {
@@ -76,6 +77,7 @@ struct CutEdit {
   /// `nearest` the one nearest `seed` (a limb, not every limb the plane crosses), else all.
   enum class Region { everywhere, nearest } region = Region::nearest;
   Eigen::Vector3d seed{0.68, 0.39, 0.305};  // box fractions (cut.seed, by default `point`)
+  SeverSettings sever{true, 1e5};           // cut.release, cut.volume_modulus (Pa)
 };
 struct TearEdit {
   bool enabled = true;

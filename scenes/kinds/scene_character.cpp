@@ -8,6 +8,7 @@
 // alone (skinned, no physics; geometric_tear.hpp), opened by Algorithm 2 step 6 once the stroke
 // is done; their gap-width profiles over time (opening_profiles.hpp).
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -16,6 +17,7 @@
 #include "conform/io/weld_model.hpp"
 #include "kinds/character_edits.hpp"
 #include "kinds/event_time.hpp"
+#include "kinds/falling_pieces.hpp"
 #include "kinds/geometric_tear.hpp"
 #include "kinds/model_frame.hpp"
 #include "kinds/opening_profiles.hpp"
@@ -28,7 +30,7 @@ namespace {
 // The built-in scene `character`, the defaults of this kind (`conform scenes --show character`).
 constexpr const char* kCharacterJson = R"json({
   "scene": "character",
-  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body (nodes close to one bone ride it, blended regions follow their skinned targets softly) and, while it plays, its arm is cut off with a capped cut, its flank torn by a scalpel stroke and its base drilled through with a tube; the welded seams are measured for gaps. Units: the model is brought to metres, Y up, at import: model.units_per_metre file units make a metre (\"file\": the unit the file states, FBX's UnitScaleFactor, else 100), model.up (y or z) is the file's up axis (z is turned to y). Edits are placed on the bind pose: cut.point, cut.seed, tear.from, tear.to, drill.tip and drill.base as fractions of its bounding box, tear.blade_a and tear.blade_b as fractions of its size, drill.radius as a fraction of its diagonal, cut.normal in its axes (after model.up); material.margin is in metres, physics.gravity in m/s^2; every length in summary.json is in metres. model.animation = none plays the bind pose (what a model without animation does). cut.region = nearest cuts only the section of the plane nearest cut.seed (by default cut.point), everywhere the unbounded plane. The tear's physical opening is compared with a geometric copy: the same stroke on the animated mesh alone (CGA-skinned, no physics; the cut and the drill are not applied to it), opened by Algorithm 2 step 6 once the stroke ends by geometric.amount, a fraction of the bind pose's diagonal (summary.json: metrics.physics and metrics.geometric, max_opening in metres); profiles.points positions along the tear, profiles.snapshots profile snapshots (profiles.csv, profile_history.csv, geometric_*.ply frames, two-panel pictures). The pictures are coloured by the gap across the lips (render.scalar = gap): an imported model's rest positions are in its mesh space, whose scale need not be the bind pose's, so an edge strain against them (stretch) would not be the skin's.",
+  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body (nodes close to one bone ride it, blended regions follow their skinned targets softly) and, while it plays, its arm is cut off with a capped cut, its flank torn by a scalpel stroke and its base drilled through with a tube; the welded seams are measured for gaps. Units: the model is brought to metres, Y up, at import: model.units_per_metre file units make a metre (\"file\": the unit the file states, FBX's UnitScaleFactor, else 100), model.up (y or z) is the file's up axis (z is turned to y). Edits are placed on the bind pose: cut.point, cut.seed, tear.from, tear.to, drill.tip and drill.base as fractions of its bounding box, tear.blade_a and tear.blade_b as fractions of its size, drill.radius as a fraction of its diagonal, cut.normal in its axes (after model.up); material.margin is in metres, physics.gravity in m/s^2; every length in summary.json is in metres. model.animation = none plays the bind pose (what a model without animation does). cut.region = nearest cuts only the section of the plane nearest cut.seed (by default cut.point), everywhere the unbounded plane. cut.release lets the pieces the cut severs fall (released from skinning; a closed, capped piece keeps its volume with the bulk modulus cut.volume_modulus, Pa) onto the ground (ground.enabled; ground.height in metres, by default the bind pose's lowest point), which only released pieces meet (summary.json: released_pieces, metrics.csv: released_lowest_m, falling.png). The tear's physical opening is compared with a geometric copy: the same stroke on the animated mesh alone (CGA-skinned, no physics; the cut and the drill are not applied to it), opened by Algorithm 2 step 6 once the stroke ends by geometric.amount, a fraction of the bind pose's diagonal (summary.json: metrics.physics and metrics.geometric, max_opening in metres); profiles.points positions along the tear, profiles.snapshots profile snapshots (profiles.csv, profile_history.csv, geometric_*.ply frames, two-panel pictures). The pictures are coloured by the gap across the lips (render.scalar = gap): an imported model's rest positions are in its mesh space, whose scale need not be the bind pose's, so an edge strain against them (stretch) would not be the skin's.",
   "seed": 1,
   "duration": 1.56,
   "model": { "file": "/usr/share/assimp/models/FBX/huesitos.fbx", "animation": "0",
@@ -36,7 +38,8 @@ constexpr const char* kCharacterJson = R"json({
   "material": { "link_stiffness": 0.02, "target_stiffness": 2000, "target_damping": 20,
                 "kinematic_weight": 0.95, "damping": 0.01 },
   "cut": { "at": 0.3, "point": [0.68, 0.39, 0.305], "normal": [1, 0, -0.625], "cap": true,
-           "region": "nearest" },
+           "region": "nearest", "release": true, "volume_modulus": 100000 },
+  "ground": { "enabled": true },
   "tear": { "at": 0.5, "duration": 0.4, "samples": 12, "from": [0.1, 0.75, 1.0],
             "to": [0.3, 0.75, 1.0], "blade_a": [0, 0, 0.3], "blade_b": [0, 0, -0.45] },
   "drill": { "at": 1.1, "tip": [0.6, 0.2, 0.68], "base": [-0.2, 0.2, 0.68], "radius": 0.03,
@@ -85,6 +88,8 @@ struct RunState {
   Json cut, tear, drill;
   bool cut_done = false, drill_done = false;
   double edit_ms = 0, physics_ms = 0;
+  FallingPieces falling;           // the pieces the cut severs (cut.release)
+  const Ground* ground = nullptr;  // what they fall onto (ground.enabled)
 };
 
 // The tear's physical opening against its geometric copy, with the largest of each so far.
@@ -148,6 +153,7 @@ class Character final : public Scene {
     cut_ = read_cut(root);
     tear_ = read_tear(root);
     drill_ = read_drill(root);
+    ground_ = read_ground(root, {true, std::numeric_limits<double>::quiet_NaN()});
     // The geometric copy's opening, a fraction of the bind pose's diagonal (as every length
     // placed on the model), and the profiles kept of both openings (tear-opening's keys).
     compare_ = read_comparison_keys(root);
@@ -194,12 +200,20 @@ class Character final : public Scene {
     for (std::int32_t v = 0; v < body.vertex_count(); ++v) kinematic += body.kinematic(v);
     std::vector<std::string> columns{"t",      "offset_mean_m", "offset_max_m", "seam_gap_rel",
                                      "pieces", "nodes"};
+    if (releases()) columns.push_back("released_lowest_m");
     if (compare)
       columns.insert(columns.end(), {"physics_max_opening", "geometric_max_opening", "physics_area",
                                      "geometric_area"});
     out.open_metrics(columns);
     if (compare) compare->profiles.open_history(out);
     RunState s;
+    std::optional<Ground> ground;
+    if (ground_.enabled) {
+      // By default under the bind pose's lowest point: what the character stands on.
+      ground_.height = std::isnan(ground_.height) ? bind.lo.y() : ground_.height;
+      ground.emplace(w, ground_.height, 0.5 * (bind.lo + bind.hi), bind.diagonal());
+      s.ground = &*ground;
+    }
     out.frame("character", 0, body.mesh());
     const auto loop_start = Clock::now();
     for (int step = 1; step <= c.steps; ++step) {
@@ -223,6 +237,7 @@ class Character final : public Scene {
                     {"physics_ms_per_step", s.physics_ms / c.steps},
                     {"edits_ms", s.edit_ms}};
     add_plots(out);
+    if (releases()) out.add_plot(falling_plot("character", ground_.enabled, cut_.at));
     if (compare) {
       add_comparison(*compare, body, bind, metrics);
       timings["geometric_copy_ms"] = compare->ms;
@@ -277,6 +292,8 @@ class Character final : public Scene {
     return &model.animations[static_cast<std::size_t>(a)];
   }
 
+  bool releases() const { return cut_.enabled && cut_.sever.release; }
+
   // Every enabled edit happens before the last step (else it would be skipped unsaid).
   void require_edits_before_end(const CommonSettings& c) const {
     if (cut_.enabled) require_before_end(c, "cut.at", cut_.at, "the cut", cut_.at);
@@ -290,9 +307,12 @@ class Character final : public Scene {
   void edit(bullet::SkinnedSoftBody& body, const BindPose& bind, TearRun& tear,
             TearCompare* compare, double t, RunState& s) const {
     if (cut_.enabled && !s.cut_done && event_due(t, cut_.at)) {
+      s.falling.before_cut(body);
       s.cut = apply_cut(body, bind, cut_);
       s.cut_done = true;
       if (s.cut["status"] != "cut") std::cerr << "warning: the cut missed the model\n";
+      if (releases() && s.cut["status"] == "cut")
+        s.cut["released"] = s.falling.release_severed(body, cut_.sever.volume_modulus, s.ground);
     }
     if (tear_.enabled) advance_tear(body, bind, tear, compare, t);
     if (drill_.enabled && !s.drill_done && event_due(t, drill_.at)) {
@@ -327,9 +347,11 @@ class Character final : public Scene {
     s.worst_seam_gap = std::max(s.worst_seam_gap, gap);
     const double t = step * c.dt;
     if (compare) compare->measure(body);
+    s.falling.measure(body, s.ground);
     if (step % c.metrics_every == 0 || step == c.steps) {
       std::vector<double> row{
           t, o.mean, o.max, gap, double(body.piece_count()), double(body.vertex_count())};
+      if (releases()) row.push_back(s.falling.any() ? s.falling.lowest() : RunOutput::Csv::kAbsent);
       if (compare) {
         const TearCompare& k = *compare;
         row.insert(row.end(), {k.phys.max, k.geom.max, k.phys.area, k.geom.area});
@@ -366,7 +388,7 @@ class Character final : public Scene {
     };
     m["physics"] = part(k.phys, k.max_phys, body.tear());
     m["geometric"] = part(k.geom, k.max_geom, &k.geo.tear());
-    m["geometric"]["amount"] = compare_.amount;  // of the bind pose's diagonal
+    m["geometric"]["amount"] = compare_.amount;                      // of the bind pose's diagonal
     m["geometric"]["amount_m"] = compare_.amount * bind.diagonal();  // metres
     m["physics_over_geometric_max_opening"] = k.geom.max > 0 ? k.phys.max / k.geom.max : 0.0;
     m["opening_units"] = "metres, square metres; profile_r2 of w_max*sqrt(1-(2s-1)^2)";
@@ -415,6 +437,9 @@ class Character final : public Scene {
                "when model.up is z); secondary motion = distance of a node from its "
                "CGA-skinned target; edit placements are fractions of the bind pose's box"}};
     if (cut_.enabled) m["cut"] = s.cut;
+    if (releases()) m["released_pieces"] = s.falling.summary();
+    m["ground"] = {{"enabled", ground_.enabled}};
+    if (ground_.enabled) m["ground"]["height_m"] = ground_.height;
     if (tear_.enabled) m["tear"] = s.tear;
     if (drill_.enabled) m["drill"] = s.drill;
     return m;
@@ -446,6 +471,7 @@ class Character final : public Scene {
   CutEdit cut_;
   TearEdit tear_;
   DrillEdit drill_;
+  GroundSettings ground_;
   ComparisonKeys compare_;  // geometric.amount is a fraction of the bind pose's diagonal
 };
 

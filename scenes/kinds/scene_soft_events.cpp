@@ -9,11 +9,13 @@
 #include <chrono>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include "conform/mesh/analysis.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "conform/skin/skinner.hpp"
 #include "kinds/event_time.hpp"
+#include "kinds/falling_pieces.hpp"
 #include "kinds/scene.hpp"
 #include "kinds/soft_scene.hpp"
 
@@ -23,14 +25,16 @@ namespace {
 // The built-in scene `cut`, the defaults of this kind (`conform scenes --show cut`).
 constexpr const char* kCutJson = R"json({
   "scene": "cut",
-  "description": "The moving procedural arm as a CGA-skinned Bullet soft body (every node pulled toward its skinned target) is cut through the forearm by a plane; both pieces keep simulating under gravity and the hand piece keeps following the wrist and hand bones.",
+  "description": "The moving procedural arm as a CGA-skinned Bullet soft body (every node pulled toward its skinned target) is cut through the forearm by a plane; both pieces keep simulating under gravity and the hand piece keeps following the wrist and hand bones. With cut.release the hand piece is released from skinning instead and falls (a capped piece, cut.cap, keeps its volume with the bulk modulus cut.volume_modulus, Pa) onto the ground (ground.enabled, its top at ground.height, m), which only released pieces meet.",
   "seed": 1,
   "duration": 3.0,
   "model": { "resolution": 1 },
   "pose": { "shoulder_swing_deg": 20, "elbow_deg": 10, "elbow_swing_deg": 40, "period": 2 },
   "material": { "target_stiffness": 4000, "target_damping": 40, "kinematic_weight": 2,
                 "damping": 0.02 },
-  "cut": { "at": 0.5, "point": [0, 0, 0.4234], "normal": [0, 0.05, 1], "cap": false },
+  "cut": { "at": 0.5, "point": [0, 0, 0.4234], "normal": [0, 0.05, 1], "cap": false,
+           "release": false, "volume_modulus": 100000 },
+  "ground": { "enabled": false, "height": -0.5 },
   "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
                "gravity": [0, -9.81, 0] },
   "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
@@ -131,6 +135,7 @@ class ArmEventScene : public Scene {
       normal_ = ev.vec3("normal", Vec3(0, 0.05, 1));
       if (normal_.norm() < 1e-9) ev.fail("normal", Json{0, 0, 0}, "must not be zero");
       cap_ = ev.boolean("cap", false);
+      sever_ = read_sever(ev, {false, 1e5});
     } else {
       tip_ = ev.vec3("tip", Vec3(0.1, 0.0031, 0.1512));
       base_ = ev.vec3("base", Vec3(-0.1, 0.0031, 0.1512));
@@ -139,6 +144,8 @@ class ArmEventScene : public Scene {
         ev.fail("tip", Json{tip_.x(), tip_.y(), tip_.z()}, "must differ from base");
     }
     ev.finish();
+    // Under the arm's lowest reach (0.7 m at a 20 degree swing: 0.24 m below the shoulder).
+    if (kind == Kind::cut) ground_ = read_ground(root, {false, -0.5});
     common_ = read_common(root, name, 3.0, steps_override);
     root.finish();
   }
@@ -155,12 +162,27 @@ class ArmEventScene : public Scene {
     const bool is_cut = kind_ == Kind::cut;
     require_before_end(c, is_cut ? "cut.at" : "drill.at", at_, is_cut ? "the cut" : "the drill",
                        at_);
-    out.open_metrics(is_cut ? std::vector<std::string>{"t", "pieces", "offset_mean", "offset_max",
-                                                       "hand_offset_mean", "hand_offset_max",
-                                                       "rest_offset_mean", "nodes"}
-                            : std::vector<std::string>{"t", "holes", "offset_mean", "offset_max",
-                                                       "rim_offset_mean", "rim_offset_max",
-                                                       "rim_vertices", "nodes"});
+    std::vector<std::string> columns = is_cut ? std::vector<std::string>{"t",
+                                                                         "pieces",
+                                                                         "offset_mean",
+                                                                         "offset_max",
+                                                                         "hand_offset_mean",
+                                                                         "hand_offset_max",
+                                                                         "rest_offset_mean",
+                                                                         "nodes"}
+                                              : std::vector<std::string>{"t",
+                                                                         "holes",
+                                                                         "offset_mean",
+                                                                         "offset_max",
+                                                                         "rim_offset_mean",
+                                                                         "rim_offset_max",
+                                                                         "rim_vertices",
+                                                                         "nodes"};
+    if (sever_.release) columns.push_back("released_lowest_m");
+    out.open_metrics(columns);
+    std::optional<Ground> ground;
+    if (ground_.enabled) ground.emplace(w, ground_.height, Vec3(0, 0, 0.35), 1.0);
+    FallingPieces falling;
     bool done = false;
     int holes = 0;
     double event_ms = 0, physics_ms = 0;
@@ -178,30 +200,36 @@ class ArmEventScene : public Scene {
       if (!done && event_due(t, at_)) {
         done = true;
         const auto te = Clock::now();
+        if (is_cut) falling.before_cut(body);
         event = is_cut ? cut_at(body, arm, t, special, others)
                        : drill_at(body, arm, t, holes, special, others);
+        if (sever_.release)
+          event["released"] =
+              falling.release_severed(body, sever_.volume_modulus, ground ? &*ground : nullptr);
         event_ms = std::chrono::duration<double, std::milli>(Clock::now() - te).count();
         continue;  // offsets are measured once the plugin has skinned the new vertices
       }
       const OffsetStats all = offsets(body, {});
+      falling.measure(body, ground ? &*ground : nullptr);
       // The hand piece (or the rim) and the rest do not exist before the event: blank, not 0.
       constexpr double absent = RunOutput::Csv::kAbsent;
       OffsetStats sp{absent, absent}, rs{absent, absent};
-      if (!special.empty()) {
+      if (!special.empty() && !falling.any()) {  // a released hand is not skinned
         sp = offsets(body, special);
         rs = offsets(body, others);
         worst_special.max = std::max(worst_special.max, sp.max);
         all_special.mean += sp.mean, ++special_samples;
       }
       if (step % c.metrics_every == 0 || step == c.steps) {
-        const double row[] = {t,
-                              is_cut ? double(body.piece_count()) : double(holes),
-                              all.mean,
-                              all.max,
-                              sp.mean,
-                              sp.max,
-                              is_cut ? rs.mean : double(special.size()),
-                              double(body.vertex_count())};
+        std::vector<double> row{t,
+                                is_cut ? double(body.piece_count()) : double(holes),
+                                all.mean,
+                                all.max,
+                                sp.mean,
+                                sp.max,
+                                is_cut ? rs.mean : double(special.size()),
+                                double(body.vertex_count())};
+        if (sever_.release) row.push_back(falling.any() ? falling.lowest() : absent);
         out.metrics().row(row);
       }
       if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
@@ -212,7 +240,12 @@ class ArmEventScene : public Scene {
     }
     const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();
     if (!finite_nodes(body)) throw std::runtime_error("the soft body blew up (non-finite nodes)");
-    const Json metrics = summary(body, event, all_special, worst_special, special_samples);
+    Json metrics = summary(body, event, all_special, worst_special, special_samples);
+    if (sever_.release) metrics["released_pieces"] = falling.summary();
+    if (is_cut) {
+      metrics["ground"] = {{"enabled", ground_.enabled}};
+      if (ground_.enabled) metrics["ground"]["height_m"] = ground_.height;
+    }
     add_plot(out);
     Json timings = {{"physics_ms_per_step", physics_ms / c.steps}, {"event_ms", event_ms}};
     out.finish(resolved_, metrics, timings, c.steps, c.steps * c.dt, loop_s);
@@ -300,6 +333,7 @@ class ArmEventScene : public Scene {
                    {"metrics.csv", "t", what + "_offset_max", name + " (max)", "lines", 1e3}};
     plot.events = {{at_, is_cut ? "cut" : "drill"}};
     out.add_plot(std::move(plot));
+    if (sever_.release) out.add_plot(falling_plot("cut", ground_.enabled, at_));
   }
 
  private:
@@ -311,6 +345,8 @@ class ArmEventScene : public Scene {
   Vec3 point_, normal_, tip_, base_;
   double radius_ = 0.01;
   bool cap_ = false;
+  SeverSettings sever_;    // cut.release: the hand piece falls (the cut's parts but the largest)
+  GroundSettings ground_;  // what it falls onto
 };
 
 std::unique_ptr<Scene> make_cut(const Json& scene, const std::string& name, int steps) {

@@ -30,6 +30,8 @@ OffsetStats offsets(const bullet::SkinnedSoftBody& body,
                     const std::vector<std::int32_t>& vertices) {
   OffsetStats s;
   const auto add = [&](std::int32_t v) {
+    const bullet::PieceId piece = body.piece_of(v);
+    if (!piece.is_null() && body.piece_released(piece)) return;  // no longer skinned
     const double d = (body.position(v) - body.target(v)).norm();
     s.mean += d, s.max = std::max(s.max, d), ++s.n;
   };

@@ -33,7 +33,7 @@ struct OffsetStats {
   double mean = 0, max = 0;
   long n = 0;
 };
-/// Over `vertices` (all when empty).
+/// Over `vertices` (all when empty), leaving out the released pieces' (no longer skinned).
 OffsetStats offsets(const bullet::SkinnedSoftBody& body, const std::vector<std::int32_t>& vertices);
 /// Every node position finite.
 bool finite_nodes(const bullet::SkinnedSoftBody& body);

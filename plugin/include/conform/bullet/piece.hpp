@@ -80,7 +80,11 @@ struct ReleaseOptions {
   /// (9 × the skin's weight per area, 1.1 kg/m² × g) it sags under its own weight.
   double volume_modulus = 0.0;
   /// An inner pressure in Pa at the release volume (>= 0; 0 = off), following Boyle's law
-  /// (p V = p0 V0), integrated implicitly as the modulus is. Needs a closed piece.
+  /// (p V = p0 V0), integrated implicitly as the modulus is. Needs a closed piece. Unlike the
+  /// modulus it pushes at V0 too, and the links (solved by position) must carry its tension
+  /// p R / 2: 100 Pa holds the 5 cm forearm piece up (104 % of its volume), 1000 Pa at 1/240 s
+  /// pushed its bottom through the box it landed on. Keep it within about 10 × the skin's
+  /// weight per area, or keep the volume with volume_modulus.
   double pressure = 0.0;
 };
 
