@@ -41,9 +41,6 @@ void SkinnedSoftBody::Impl::release_piece(PieceId id, const ReleaseOptions& opti
   piece.released = true;
   piece.release = options;
   body.m_materials[0]->m_kLST = btScalar(options.link_stiffness);
-  // A plain Bullet body from now on, in either model: Bullet's damping (a membrane's bodies
-  // run with none, the membrane's own being the attachment's, which a free piece has not).
-  body.m_cfg.kDP = btScalar(material_.damping);
   release_nodes(piece);
   // The shape at release is the rest shape from now on (what Bullet's own reset would give).
   for (int i = 0; i < body.m_links.size(); ++i) {

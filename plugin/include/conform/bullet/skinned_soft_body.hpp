@@ -88,7 +88,7 @@ struct Material {
   double link_stiffness = 0.9;
   /// bullet_links: Bullet's damping kDP, dimensionless in [0, 1): fraction of velocity removed
   /// per substep. The membrane ignores it (its bodies run with kDP = 0): its damping is
-  /// skin.attachment_damping, in Pa s/m. Released pieces (release_piece) take it in either.
+  /// skin.attachment_damping, in Pa s/m.
   double damping = 0.0;
   /// Pretension s, dimensionless in [0, 1): a link's rest length is (1 − s) × its length when
   /// the link is made (at creation, or when a topology change adds it).
