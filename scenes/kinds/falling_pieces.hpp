@@ -34,8 +34,8 @@ struct SeverSettings {
 SeverSettings read_sever(Reader& cut, const SeverSettings& defaults);
 
 /// A static box whose top is at `height`, `size` (m, the model's scale) wide on each side of
-/// `centre`. It sets the soft bodies' contact grid (Bullet's sparse SDF) to size / 100: at
-/// Bullet's 0.25 m a 5 cm piece sinks into a box (tests/plugin_release_test.cpp).
+/// `centre` and 2 size thick. It sets the soft bodies' contact grid (Bullet's sparse SDF) to size /
+/// 100: at Bullet's 0.25 m a 5 cm piece sinks into a box (tests/plugin_release_test.cpp).
 class Ground {
  public:
   static constexpr int kGroup = 1 << 6;  // broadphase group: meets only released pieces
@@ -44,6 +44,8 @@ class Ground {
   Ground(const Ground&) = delete;
   Ground& operator=(const Ground&) = delete;
   double height() const { return height_; }
+  /// Refines the soft bodies' contact grid for a released piece of `piece_size` (m).
+  void fit_contact_grid(double piece_size);
 
  private:
   SoftWorld& world_;
@@ -60,7 +62,7 @@ class FallingPieces {
   /// After it: of each piece the cut split, every part but the one with the most vertices (the
   /// body the cut was made on) is released, with `volume_modulus` when it is closed (0 when
   /// open), and meets `ground`.
-  Json release_severed(bullet::SkinnedSoftBody& body, double volume_modulus, const Ground* ground);
+  Json release_severed(bullet::SkinnedSoftBody& body, double volume_modulus, Ground* ground);
   /// After each step: the released pieces' lowest node above the ground, speed and volume.
   void measure(const bullet::SkinnedSoftBody& body, const Ground* ground);
   /// The lowest released node's height above the ground (or its y without one), m; NaN before

@@ -88,8 +88,8 @@ struct RunState {
   Json cut, tear, drill;
   bool cut_done = false, drill_done = false;
   double edit_ms = 0, physics_ms = 0;
-  FallingPieces falling;           // the pieces the cut severs (cut.release)
-  const Ground* ground = nullptr;  // what they fall onto (ground.enabled)
+  FallingPieces falling;     // the pieces the cut severs (cut.release)
+  Ground* ground = nullptr;  // what they fall onto (ground.enabled)
 };
 
 // The tear's physical opening against its geometric copy, with the largest of each so far.
