@@ -88,6 +88,7 @@ void read_skin(Reader& r, const bullet::Material& d, bullet::Material& m) {
       r.number("attachment_normal_stiffness", e.attachment_normal_stiffness, 0, 1e12);
   k.attachment_damping = r.number("attachment_damping", e.attachment_damping, 0, 1e9);
   k.wrinkling = r.boolean("wrinkling", e.wrinkling);
+  k.toughness = r.number("toughness", e.toughness, 1e-9, 1e6);
   using Law = membrane::SkinMaterial::Law;
   const std::array<std::pair<Law, const char*>, 3> laws = {
       {{Law::stvk, "stvk"},

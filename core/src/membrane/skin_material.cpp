@@ -54,6 +54,8 @@ void SkinMaterial::validate() const {
           attachment_stiffness, ">= 0 Pa/m");
   require(finite(attachment_normal_stiffness) && attachment_normal_stiffness >= 0,
           "attachment_normal_stiffness", attachment_normal_stiffness, ">= 0 Pa/m");
+  require(finite(toughness) && toughness > 0 && toughness <= 1e6, "toughness", toughness,
+          "(0, 1e6] J/m^2");
   require(finite(attachment_damping) && attachment_damping >= 0, "attachment_damping",
           attachment_damping, ">= 0 Pa s/m");
 }

@@ -35,6 +35,12 @@
 //     tangent of the uniaxial nominal stress along the fibres at their mean failure strain, 54 %,
 //     70.6 x its value at zero strain, their ratio of the mean linear-region modulus to the mean
 //     initial slope (83.3 and 1.18 MPa): skin's J-shaped curve (membrane_law_test checks both).
+//   - Toughness (critical energy release rate) G_c: published values for skin span about
+//     1-30 kJ/m^2 depending on the test (trouser tear, notched tension, scissors cutting) and
+//     on species and site; the default, 2 kJ/m^2, is an order of magnitude within that span,
+//     not one measurement. At it, Griffith's stress sqrt(E G_c / (pi a)) of a 1 cm slit in the
+//     default skin is about 0.23 MPa, 0.55 E: skin is notch-insensitive at these sizes, and
+//     linear fracture mechanics (membrane-griffith) needs a far lower G_c to stay at small strain.
 //   - Damping: not measured in these units; the default is about critical for the attachment,
 //     2 sqrt(k rho_A) = 1.6e3 Pa s/m, so that secondary motion settles in tens of milliseconds.
 #pragma once
@@ -108,6 +114,11 @@ struct SkinMaterial {
   /// Viscous damping of the velocity relative to the target's, Pa s/m = N s/m^3, >= 0
   /// (default 1.6e3 Pa s/m).
   double attachment_damping = 1.6e3;
+  /// Toughness G_c, J/m^2: the energy per unit area of new crack surface through the thickness
+  /// (a crack of length a in a membrane of thickness t releases G t da), at which a tear grows
+  /// (membrane/crack_growth.hpp). In (0, 1e6] (human skin about 1e3-3e4; default 2e3, see the
+  /// sources above). Unused unless crack growth is asked for.
+  double toughness = 2.0e3;
   /// Wrinkling: the membrane carries no compression (tension-field theory, Pipkin 1986): where
   /// a principal stress would go negative the skin buckles out of its plane instead, and the
   /// relaxed energy of detail/tension_field.hpp (stvk) or detail/neo_hookean.hpp (neo_hookean)
