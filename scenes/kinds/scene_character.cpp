@@ -200,7 +200,8 @@ class Character final : public Scene {
     out.open_metrics(columns);
     if (compare) compare->profiles.open_history(out);
     RunState s;
-    out.frame("character", 0, body.mesh());
+    const Lips no_lips_yet;  // with a tear, the gap is 0 until it starts
+    out.body_frame("character", 0, body, compare ? &no_lips_yet : nullptr);
     const auto loop_start = Clock::now();
     for (int step = 1; step <= c.steps; ++step) {
       const auto tp = Clock::now();
@@ -344,14 +345,14 @@ class Character final : public Scene {
   static void write_frame(bullet::SkinnedSoftBody& body, const TearCompare* compare, int step,
                           RunOutput& out) {
     body.sync_mesh();
-    out.frame("character", step, body.mesh());
+    const Lips lips = tear_lips(body.tear());
+    out.body_frame("character", step, body, compare ? &lips : nullptr);
     if (!compare) return;
     out.frame("geometric", step, compare->geo.mesh());
     // The physical panel is named as its frames, so run.glb keeps one sequence of the body.
-    out.picture(step,
-                {{"character", &body.mesh(), tear_lips(body.tear()), gap_caption(compare->phys)},
-                 {"geometric", &compare->geo.mesh(), tear_lips(&compare->geo.tear()),
-                  gap_caption(compare->geom)}});
+    out.picture(step, {{"character", &body.mesh(), lips, gap_caption(compare->phys)},
+                       {"geometric", &compare->geo.mesh(), tear_lips(&compare->geo.tear()),
+                        gap_caption(compare->geom)}});
   }
 
   // metrics.physics and metrics.geometric: each opening at the end and its largest over the
@@ -366,7 +367,7 @@ class Character final : public Scene {
     };
     m["physics"] = part(k.phys, k.max_phys, body.tear());
     m["geometric"] = part(k.geom, k.max_geom, &k.geo.tear());
-    m["geometric"]["amount"] = compare_.amount;  // of the bind pose's diagonal
+    m["geometric"]["amount"] = compare_.amount;                      // of the bind pose's diagonal
     m["geometric"]["amount_m"] = compare_.amount * bind.diagonal();  // metres
     m["physics_over_geometric_max_opening"] = k.geom.max > 0 ? k.phys.max / k.geom.max : 0.0;
     m["opening_units"] = "metres, square metres; profile_r2 of w_max*sqrt(1-(2s-1)^2)";
