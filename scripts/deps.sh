@@ -19,6 +19,7 @@ packages=(
   pybind11-dev python3-dev  # the Python module conform (python/), for Debian's /usr/bin/python3
   python3-numpy python3-pytest  # its arrays and its test suite (ctest python_test)
   python3-matplotlib  # examples/python: the plots
+  python3-meshio  # conform run's ParaView series (outputs.vtk, --vtk): it writes the .vtu files
 )
 
 missing=()

@@ -25,6 +25,7 @@ struct RunArgs {
   int steps = 0;
   std::vector<std::string> sets;
   bool no_render = false;
+  bool vtk = false;
 };
 
 void print_metrics(const scenes::Json& j, const std::string& prefix) {
@@ -109,6 +110,9 @@ int run_scene(const std::string& scene, const std::string& out_dir, int steps,
                           summary["render"].value("pictures", scenes::Json::array()).size() > 0
                       ? ", pictures/*.png"
                       : "")
+              << (summary.is_object() && summary.contains("vtk") && summary["vtk"].contains("pvd")
+                      ? ", vtk/series.pvd"
+                      : "")
               << ")\n";
     if (!failures.empty()) {
       std::cerr << "conform run: " << prepared->common().name << ": the run is incomplete ("
@@ -145,9 +149,12 @@ void register_run(CLI::App& app, Context& context) {
       ->allow_extra_args(false);
   cmd->add_flag("--no-render", args->no_render,
                 "no pictures, video or run.glb (the scene's \"render\": false)");
+  cmd->add_flag("--vtk", args->vtk,
+                "also write the ParaView series vtk/series.pvd (the scene's outputs.vtk: true)");
   cmd->callback([&context, args]() {
     // Last, so that it wins over any --set render.KEY=VALUE.
     if (args->no_render) args->sets.push_back("render=false");
+    if (args->vtk) args->sets.push_back("outputs.vtk=true");
     context.exit_code = run_scene(args->scene, args->out, args->steps, args->sets);
   });
 }

@@ -14,10 +14,12 @@
 #include "conform/bullet/convert.hpp"
 #include "conform/io/mesh_export.hpp"
 #include "conform/version.hpp"
+#include "kinds/body_fields.hpp"
 #include "kinds/output_caps.hpp"
 #include "kinds/provenance.hpp"
 #include "render/gltf_sequence.hpp"
 #include "render/render_frames.hpp"
+#include "render/vtk_series.hpp"
 
 namespace conform::scenes {
 
@@ -46,6 +48,7 @@ CommonSettings read_common(Reader& root, const std::string& name, double default
   c.metrics_every = outputs.integer("metrics_every", 1, 1, 1000000);
   c.frames_every = outputs.integer("frames_every", 0, 0, 1000000);
   c.plots = outputs.boolean("plots", true);
+  c.vtk = outputs.boolean("vtk", false);
   outputs.finish();
   c.render = read_render(root);
   // In double first: int(duration / dt) overflowed to a 1-step run that reported success.
@@ -97,6 +100,7 @@ RunOutput::RunOutput(fs::path dir, const CommonSettings& common)
   if (common_.render.enabled)
     pictures_ = std::make_unique<PictureRenderer>(common_.render, dir_, common_.name);
   if (common_.render.glb) gltf_ = std::make_unique<GltfSequence>();
+  if (common_.vtk) vtk_ = std::make_unique<VtkSeries>(dir_);
 }
 
 RunOutput::~RunOutput() = default;
@@ -118,6 +122,12 @@ void RunOutput::frame(const std::string& name, int step, const mesh::SkinnedMesh
   // A piece (a subset of faces) is not a frame of the sequence: its whole mesh is.
   if (gltf_ && faces.empty())
     gltf_->add(snapshot(name, step, step * common_.dt, mesh, {}, common_.render.scalar));
+}
+
+void RunOutput::body_frame(const std::string& name, int step, const bullet::SkinnedSoftBody& body,
+                           const Lips* lips) {
+  frame(name, step, body.mesh());
+  if (vtk_) vtk_->add(name, step, step * common_.dt, body_fields(body, lips));
 }
 
 void RunOutput::picture(int step, const std::vector<PicturePanel>& panels) {
@@ -212,6 +222,13 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
       std::chrono::duration<double, std::milli>(Clock::now() - plots_start).count();
   const Json render = finish_render(render_start, plots_ms, loop_seconds, steps);
   for (const auto& f : render.value("failures", Json::array())) failures_.push_back(f);
+  Json vtk;
+  if (vtk_) {
+    const auto t1 = Clock::now();
+    vtk = vtk_->finish();
+    vtk["ms"] = std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+    for (const auto& f : vtk["failures"]) failures_.push_back(f);
+  }
   const double wall = std::chrono::duration<double>(Clock::now() - start_).count();
   Json summary;
   summary["scene"] = common_.name;
@@ -242,6 +259,7 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   summary["plots"] = plots;
   if (!plot_notes.empty()) summary["plot_notes"] = plot_notes;
   summary["render"] = render;
+  if (vtk_) summary["vtk"] = vtk;
   summary["failures"] = failures_;
   // Settings, timings and what the scene added: JSON would hold NaN or inf as null.
   require_finite(summary, "summary.json");

@@ -1,5 +1,6 @@
 // What a scene run writes into its folder: metrics.csv (a time series), summary.json (settings,
-// version, timings, final metrics), frames (PLY) and PNG plots drawn by gnuplot from the CSV.
+// version, timings, final metrics), frames (PLY), PNG plots drawn by gnuplot from the CSV and,
+// with outputs.vtk, the ParaView series of the body's frames (vtk/).
 // The folder is created only when the run starts, i.e. after the scene parsed.
 #pragma once
 
@@ -20,6 +21,10 @@
 #include "render/frame_snapshot.hpp"
 #include "render/plots.hpp"
 #include "render/render_settings.hpp"
+
+namespace conform::bullet {
+class SkinnedSoftBody;
+}
 
 namespace conform::scenes {
 
@@ -43,12 +48,14 @@ struct CommonSettings {
   int metrics_every = 1;  // steps between metric rows
   int frames_every = 0;   // steps between PLY frames (0: first and last only)
   bool plots = true;
-  int threads = 1;          // OpenMP threads (0: OpenMP's default)
+  bool vtk = false;  // the ParaView series: vtk/*.vtu and vtk/series.pvd (render/vtk_series.hpp)
+  int threads = 1;   // OpenMP threads (0: OpenMP's default)
   RenderSettings render{};  // pictures, video and run.glb (render_settings.hpp)
 };
 
 class PictureRenderer;
 class GltfSequence;
+class VtkSeries;
 
 /// One run's surface in a picture: its name (the panel's title), its mesh and its wound.
 struct PicturePanel {
@@ -91,6 +98,12 @@ class RunOutput {
              std::span<const std::int32_t> faces = {});
   int frames_written() const { return frames_; }
 
+  /// A frame of the simulated body: frames/NAME_STEP.ply (frame()) and, with outputs.vtk, its
+  /// vertex fields for the ParaView series (kinds/body_fields.hpp). `lips` is the wound's, null
+  /// when the scene makes none (the series then has no gap). Call it after body.sync_mesh().
+  void body_frame(const std::string& name, int step, const bullet::SkinnedSoftBody& body,
+                  const Lips* lips = nullptr);
+
   /// Offers a picture of this step: the panels side by side, rendered when the run finishes
   /// (render_frames.hpp; a no-op with "render": false). Call it beside frame().
   void picture(int step, const std::vector<PicturePanel>& panels);
@@ -126,6 +139,7 @@ class RunOutput {
   std::vector<Plot> plots_;
   std::unique_ptr<PictureRenderer> pictures_;
   std::unique_ptr<GltfSequence> gltf_;
+  std::unique_ptr<VtkSeries> vtk_;
   int frames_ = 0;
   std::unique_ptr<Progress> progress_;
   std::vector<std::string> failures_;

@@ -214,7 +214,8 @@ class Character final : public Scene {
       ground.emplace(w, ground_.height, 0.5 * (bind.lo + bind.hi), bind.diagonal());
       s.ground = &*ground;
     }
-    out.frame("character", 0, body.mesh());
+    const Lips no_lips_yet;  // with a tear, the gap is 0 until it starts
+    out.body_frame("character", 0, body, compare ? &no_lips_yet : nullptr);
     const auto loop_start = Clock::now();
     for (int step = 1; step <= c.steps; ++step) {
       const auto tp = Clock::now();
@@ -366,14 +367,14 @@ class Character final : public Scene {
   static void write_frame(bullet::SkinnedSoftBody& body, const TearCompare* compare, int step,
                           RunOutput& out) {
     body.sync_mesh();
-    out.frame("character", step, body.mesh());
+    const Lips lips = tear_lips(body.tear());
+    out.body_frame("character", step, body, compare ? &lips : nullptr);
     if (!compare) return;
     out.frame("geometric", step, compare->geo.mesh());
     // The physical panel is named as its frames, so run.glb keeps one sequence of the body.
-    out.picture(step,
-                {{"character", &body.mesh(), tear_lips(body.tear()), gap_caption(compare->phys)},
-                 {"geometric", &compare->geo.mesh(), tear_lips(&compare->geo.tear()),
-                  gap_caption(compare->geom)}});
+    out.picture(step, {{"character", &body.mesh(), lips, gap_caption(compare->phys)},
+                       {"geometric", &compare->geo.mesh(), tear_lips(&compare->geo.tear()),
+                        gap_caption(compare->geom)}});
   }
 
   // metrics.physics and metrics.geometric: each opening at the end and its largest over the

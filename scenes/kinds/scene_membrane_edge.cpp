@@ -190,7 +190,7 @@ Json MembraneEdge::run(RunOutput& out) {
   EdgeProfile profile;
   membrane::SolveReport last;
   double physics_ms = 0;
-  out.frame("sheet", 0, body.mesh());
+  out.body_frame("sheet", 0, body);
   const auto loop_start = Clock::now();
   for (int step = 1; step <= c.steps; ++step) {
     const double t = step * c.dt;
@@ -227,7 +227,7 @@ Json MembraneEdge::run(RunOutput& out) {
     }
     if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
       body.sync_mesh();
-      out.frame("sheet", step, body.mesh());
+      out.body_frame("sheet", step, body);
     }
     out.progress(step, c.steps);
   }

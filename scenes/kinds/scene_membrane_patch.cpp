@@ -152,7 +152,7 @@ class MembranePatch final : public Scene {
     u_offset.reserve(std::size_t(c.steps));
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     double physics_ms = 0, worst_relative = 0;
-    out.frame("patch", 0, body.mesh());
+    out.body_frame("patch", 0, body);
     const auto loop_start = Clock::now();
     for (int step = 1; step <= c.steps; ++step) {
       const auto tp = Clock::now();
@@ -172,7 +172,7 @@ class MembranePatch final : public Scene {
       }
       if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
         body.sync_mesh();
-        out.frame("patch", step, body.mesh());
+        out.body_frame("patch", step, body);
       }
       out.progress(step, c.steps);
     }

@@ -103,7 +103,7 @@ class MembraneSlit final : public Scene {
     bool slit = false;
     double physics_ms = 0;
     std::vector<double> w_now;
-    out.frame("sheet", 0, body.mesh());
+    out.body_frame("sheet", 0, body);
     const auto loop_start = Clock::now();
     for (int step = 1; step <= c.steps; ++step) {
       const double t = step * c.dt;
@@ -127,7 +127,7 @@ class MembraneSlit final : public Scene {
       if (slit && step == c.steps) last_ = r;
       if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
         body.sync_mesh();
-        out.frame("sheet", step, body.mesh());
+        out.body_frame("sheet", step, body);
       }
       out.progress(step, c.steps);
     }

@@ -190,7 +190,7 @@ class ArmEventScene : public Scene {
     std::vector<std::int32_t> special, others;  // hand (cut) or rim (drill) vertices; the rest
     OffsetStats worst_special{}, all_special{};
     long special_samples = 0;
-    out.frame("arm", 0, body.mesh());
+    out.body_frame("arm", 0, body);
     const auto loop_start = Clock::now();
     for (int step = 1; step <= c.steps; ++step) {
       const auto tp = Clock::now();
@@ -234,7 +234,7 @@ class ArmEventScene : public Scene {
       }
       if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
         body.sync_mesh();
-        out.frame("arm", step, body.mesh());
+        out.body_frame("arm", step, body);
       }
       out.progress(step, c.steps);
     }

@@ -123,7 +123,8 @@ class TearOpening final : public Scene {
                       "physics_profile_r2", "geometric_profile_r2", "pieces",
                       "physics_newton_iterations", "physics_cg_iterations", "physics_residual"});
     r.profiles.open_history(out);
-    out.frame("physics", 0, r.body.mesh());
+    const Lips no_lips_yet;
+    out.body_frame("physics", 0, r.body, &no_lips_yet);
     const auto loop_start = Clock::now();
     for (int step = 1; step <= c.steps; ++step) {
       r.physics_ms += milliseconds([&] { r.world.step(); });
@@ -133,10 +134,11 @@ class TearOpening final : public Scene {
       r.measure_ms += milliseconds([&] { measure(r, step, t, out); });
       if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
         r.body.sync_mesh();
-        out.frame("physics", step, r.body.mesh());
+        const Lips lips = tear_lips(r.body.tear());
+        out.body_frame("physics", step, r.body, &lips);
         out.frame("geometric", step, r.geo.mesh());
         out.picture(step,
-                    {{"physics", &r.body.mesh(), tear_lips(r.body.tear()), gap_caption(r.phys)},
+                    {{"physics", &r.body.mesh(), lips, gap_caption(r.phys)},
                      {"geometric", &r.geo.mesh(), tear_lips(&r.geo.tear()), gap_caption(r.geom)}});
       }
       out.progress(step, c.steps);
