@@ -39,6 +39,8 @@ void bind_skin(py::module_& m) {
       .def_readwrite("attachment_normal_stiffness", &SkinMaterial::attachment_normal_stiffness,
                      "Pa/m")
       .def_readwrite("attachment_damping", &SkinMaterial::attachment_damping, "Pa s/m")
+      .def_readwrite("toughness", &SkinMaterial::toughness,
+                     "G_c, J/m^2: energy per unit of new crack area through the thickness")
       .def_readwrite("wrinkling", &SkinMaterial::wrinkling);
 }
 

@@ -99,10 +99,12 @@ def test_released_piece_falls(world, arm):
 def test_material_fields_reach_the_body(world):
     m = conform.Material()
     m.skin.youngs_modulus = 0.85e6
+    m.skin.toughness = 5000.0
     m.skin.law = conform.SkinMaterial.Law.neo_hookean
     m.pretension = 0.1
     body = world.add_arm(material=m)
     assert body.material.skin.youngs_modulus == 0.85e6
+    assert body.material.skin.toughness == 5000.0
     assert body.material.skin.law == conform.SkinMaterial.Law.neo_hookean
     links = conform.Material()
     links.model = conform.MaterialModel.bullet_links
