@@ -24,6 +24,12 @@ GroundSettings read_ground(Reader& root, const GroundSettings& defaults) {
   return s;
 }
 
+Json ground_summary(const GroundSettings& ground) {
+  Json j = {{"enabled", ground.enabled}};
+  if (ground.enabled) j["height_m"] = ground.height;
+  return j;
+}
+
 SeverSettings read_sever(Reader& cut, const SeverSettings& defaults) {
   SeverSettings s;
   s.release = cut.boolean("release", defaults.release);

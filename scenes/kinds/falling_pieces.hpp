@@ -25,6 +25,8 @@ struct GroundSettings {
   double height = std::numeric_limits<double>::quiet_NaN();  // m; NaN: the scene's default
 };
 GroundSettings read_ground(Reader& root, const GroundSettings& defaults);
+/// summary.json's "ground": enabled, and its height_m when enabled.
+Json ground_summary(const GroundSettings& ground);
 
 /// `cut.release` (the severed pieces fall) and `cut.volume_modulus` (Pa, kept by closed pieces).
 struct SeverSettings {

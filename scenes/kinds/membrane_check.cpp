@@ -7,6 +7,14 @@
 
 namespace conform::scenes {
 
+void read_slit_sheet(Reader& root, membrane::SlitSheetOptions& options) {
+  Reader sheet = root.object("sheet");
+  options.width = sheet.number("width", 1.2, 1e-3, 100);
+  options.element_size = sheet.number("resolution", 2.5e-3, 1e-5, 1);
+  options.tip_refinement = sheet.number("tip_refinement", 16, 1, 64);
+  sheet.finish();
+}
+
 skin::Skeleton one_bone() {
   skin::Skeleton s;
   s.joints.push_back({"root", -1, skin::Versor::identity()});

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "conform/membrane/skin_material.hpp"
+#include "conform/membrane/slit_sheet.hpp"
 #include "conform/membrane/solver.hpp"
 #include "conform/skin/skeleton.hpp"
 #include "kinds/run_output.hpp"
@@ -14,6 +15,9 @@
 namespace conform::scenes {
 
 /// One root joint and one bone, both identity: a flat sheet's targets are its rest positions.
+/// The "sheet" object of the slit scenes (membrane-slit, membrane-griffith): width, resolution
+/// (the element size along the slit, m) and tip_refinement, into `options`.
+void read_slit_sheet(Reader& root, membrane::SlitSheetOptions& options);
 skin::Skeleton one_bone();
 
 /// The indices of the flagged vertices (e.g. a sheet's border, to pin).

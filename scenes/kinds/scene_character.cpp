@@ -439,8 +439,7 @@ class Character final : public Scene {
                "CGA-skinned target; edit placements are fractions of the bind pose's box"}};
     if (cut_.enabled) m["cut"] = s.cut;
     if (releases()) m["released_pieces"] = s.falling.summary();
-    m["ground"] = {{"enabled", ground_.enabled}};
-    if (ground_.enabled) m["ground"]["height_m"] = ground_.height;
+    m["ground"] = ground_summary(ground_);
     if (tear_.enabled) m["tear"] = s.tear;
     if (drill_.enabled) m["drill"] = s.drill;
     return m;

@@ -49,11 +49,7 @@ class MembraneSlit final : public Scene {
  public:
   MembraneSlit(const Json& scene, const std::string& name, int steps_override) {
     Reader root(scene, "", resolved_);
-    Reader sheet = root.object("sheet");
-    options_.width = sheet.number("width", 1.2, 1e-3, 100);
-    options_.element_size = sheet.number("resolution", 2.5e-3, 1e-5, 1);
-    options_.tip_refinement = sheet.number("tip_refinement", 16, 1, 64);
-    sheet.finish();
+    read_slit_sheet(root, options_);
     Reader slit = root.object("slit");
     options_.slit_length = slit.number("length", 0.05, 1e-4, 10);
     options_.slit_angle = slit.number("angle_deg", 0, -360, 360) * std::numbers::pi / 180;

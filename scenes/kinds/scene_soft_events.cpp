@@ -162,24 +162,7 @@ class ArmEventScene : public Scene {
     const bool is_cut = kind_ == Kind::cut;
     require_before_end(c, is_cut ? "cut.at" : "drill.at", at_, is_cut ? "the cut" : "the drill",
                        at_);
-    std::vector<std::string> columns = is_cut ? std::vector<std::string>{"t",
-                                                                         "pieces",
-                                                                         "offset_mean",
-                                                                         "offset_max",
-                                                                         "hand_offset_mean",
-                                                                         "hand_offset_max",
-                                                                         "rest_offset_mean",
-                                                                         "nodes"}
-                                              : std::vector<std::string>{"t",
-                                                                         "holes",
-                                                                         "offset_mean",
-                                                                         "offset_max",
-                                                                         "rim_offset_mean",
-                                                                         "rim_offset_max",
-                                                                         "rim_vertices",
-                                                                         "nodes"};
-    if (sever_.release) columns.push_back("released_lowest_m");
-    out.open_metrics(columns);
+    out.open_metrics(metric_columns());
     std::optional<Ground> ground;
     if (ground_.enabled) ground.emplace(w, ground_.height, Vec3(0, 0, 0.35), 1.0);
     FallingPieces falling;
@@ -242,14 +225,27 @@ class ArmEventScene : public Scene {
     if (!finite_nodes(body)) throw std::runtime_error("the soft body blew up (non-finite nodes)");
     Json metrics = summary(body, event, all_special, worst_special, special_samples);
     if (sever_.release) metrics["released_pieces"] = falling.summary();
-    if (is_cut) {
-      metrics["ground"] = {{"enabled", ground_.enabled}};
-      if (ground_.enabled) metrics["ground"]["height_m"] = ground_.height;
-    }
+    if (is_cut) metrics["ground"] = ground_summary(ground_);
     add_plot(out);
     Json timings = {{"physics_ms_per_step", physics_ms / c.steps}, {"event_ms", event_ms}};
     out.finish(resolved_, metrics, timings, c.steps, c.steps * c.dt, loop_s);
     return metrics;
+  }
+
+  // metrics.csv's columns: the hand (cut) or the rim (drill), and the released pieces' lowest
+  // node when the cut releases them.
+  std::vector<std::string> metric_columns() const {
+    const std::string what = kind_ == Kind::cut ? "hand" : "rim";
+    std::vector<std::string> columns{"t",
+                                     kind_ == Kind::cut ? "pieces" : "holes",
+                                     "offset_mean",
+                                     "offset_max",
+                                     what + "_offset_mean",
+                                     what + "_offset_max",
+                                     kind_ == Kind::cut ? "rest_offset_mean" : "rim_vertices",
+                                     "nodes"};
+    if (sever_.release) columns.push_back("released_lowest_m");
+    return columns;
   }
 
   // The cut at time t, its plane given in the rest arm and moved with the forearm (bone 1);
