@@ -94,6 +94,10 @@ expect_refused "10000 frames of .* MiB would write .* MiB, more than --max-outpu
 [[ -z "$(ls -A "$tmp/frames")" ]] || fail "a refused skin wrote frames"
 expect_refused "key 'outputs.frames_every', value 1: with 20000 steps gives 20002 frames, more than the limit of 10000" \
   run arm-track --steps 20000 --set outputs.frames_every=1 --out "$tmp/out"
+# With the ParaView series each frame is two files (PLY and .vtu): half as many frames fit.
+expect_refused "key 'outputs.frames_every', value 1: with 6000 steps gives 12004 frame files (PLY and .vtu), more than the limit of 10000" \
+  run arm-track --steps 6000 --set outputs.frames_every=1 --vtk --out "$tmp/out"
+[[ ! -e "$tmp/out" ]] || fail "a refused run wrote its folder"
 
 # --- events after the end, in every scene alike ---------------------------------------------------
 expect_refused "key 'cut.at', value 0.3: the cut is after the last step: the scene ends at 0.0833333 s (5 steps of 0.0166667 s)" \

@@ -1,5 +1,6 @@
 // `conform run`'s pictures, video and run.glb, on a short tear-opening (60 steps: the stroke
-// and its first opening, frames at steps 0, 30, 60): the pictures have the requested size and
+// and its first opening, frames at steps 0, 30, 60; two pictures, where the wound changes: the
+// first step with a wound and the last): the pictures have the requested size and
 // show something, the physics and geometric panels differ where the wound is, the wound bed's
 // colour shows through the open wound only once it is open, run.glb reads back through assimp
 // with each frame's vertex and face counts of the PLY frames (read by assimp too), and f3d opens
@@ -113,6 +114,30 @@ class SceneRender : public ::testing::Test {
     if (rc_ != 0)  // the run's own words, before TearDownTestSuite removes them
       std::printf("conform exited %d:\n%s\n", rc_, read_text(run_dir().string() + ".log").c_str());
     summary_ = Json::parse(read_text(run_dir() / "summary.json"), nullptr, false);
+    first_ = first_wound_step(run_dir() / "metrics.csv");
+  }
+  // The first step whose physical tear has two points (a wound to draw), from metrics.csv.
+  static int first_wound_step(const fs::path& csv) {
+    std::ifstream in(csv);
+    std::string line;
+    std::getline(in, line);
+    const auto column = [](const std::string& row, int k) {
+      std::size_t at = 0;
+      for (int i = 0; i < k; ++i) at = row.find(',', at) + 1;
+      return std::atof(row.c_str() + at);
+    };
+    int points = 0;  // the header's column of physics_tear_points
+    for (std::size_t at = 0; line.compare(at, 19, "physics_tear_points") != 0; ++points)
+      at = line.find(',', at) + 1;
+    while (std::getline(in, line))
+      if (column(line, points) >= 2) return int(std::lround(column(line, 0) * 60));
+    return -1;
+  }
+  // pictures/step_STEP.png's STEP.
+  static std::string stem(int step) {
+    char buf[16];
+    std::snprintf(buf, sizeof buf, "%06d", step);
+    return buf;
   }
   static void TearDownTestSuite() {
     std::error_code ec;
@@ -121,16 +146,25 @@ class SceneRender : public ::testing::Test {
   }
   static int rc_;
   static Json summary_;
+  static int first_;
 };
 int SceneRender::rc_ = -1;
 Json SceneRender::summary_;
+int SceneRender::first_ = -1;
 
 TEST_F(SceneRender, RunSucceedsAndReportsItsRenders) {
   ASSERT_EQ(rc_, 0) << read_text(run_dir().string() + ".log");
   ASSERT_TRUE(summary_.is_object());
   const Json& r = summary_["render"];
   EXPECT_TRUE(r["warnings"].empty()) << r["warnings"].dump();
-  EXPECT_EQ(r["pictures"], Json::array({"pictures/step_000030.png", "pictures/step_000060.png"}));
+  // The wound appears during the stroke (step 30 on) and changes to the end.
+  ASSERT_GT(first_, 30);
+  ASSERT_LT(first_, 40);
+  EXPECT_EQ(r["pictures"],
+            Json::array({"pictures/step_" + stem(first_) + ".png", "pictures/step_000060.png"}));
+  EXPECT_EQ(r["chosen"]["by"], "wound");
+  EXPECT_EQ(r["chosen"]["from_step"], first_);
+  EXPECT_EQ(r["chosen"]["settled_step"], 60);
   EXPECT_EQ(r["video"], "run.gif");
   EXPECT_EQ(r["camera"]["aimed_at"], "event");
   EXPECT_GT(r["render_ms_per_picture"].get<double>(), 0);
@@ -143,13 +177,12 @@ TEST_F(SceneRender, RunSucceedsAndReportsItsRenders) {
 
 TEST_F(SceneRender, PicturesHaveTheRequestedSizeAndShowTheWound) {
   ASSERT_EQ(rc_, 0);
-  for (const char* step : {"000030", "000060"}) {
-    const fs::path side = run_dir() / "pictures" / ("step_" + std::string(step) + ".png");
+  for (const std::string& step : {stem(first_), std::string("000060")}) {
+    const fs::path side = run_dir() / "pictures" / ("step_" + step + ".png");
     // Two panels, the colour bar's 170 px, the titles' 60 px and the captions' 34 px.
     EXPECT_EQ(png_size(side), (std::array<int, 2>{2 * kWidth + 170, kHeight + 60 + 34})) << side;
     // f3d renders a frame's panels side by side in one strip (physics, then geometric).
-    const fs::path strip =
-        run_dir() / "pictures" / "panels" / ("strip_" + std::string(step) + ".png");
+    const fs::path strip = run_dir() / "pictures" / "panels" / ("strip_" + step + ".png");
     EXPECT_EQ(png_size(strip), (std::array<int, 2>{2 * kWidth, kHeight})) << strip;
     for (int k = 0; k < 2; ++k) {
       const auto rgb = pixels(strip, panel_crop(k));
@@ -160,9 +193,10 @@ TEST_F(SceneRender, PicturesHaveTheRequestedSizeAndShowTheWound) {
       EXPECT_LT(foreground(rgb), kWidth * kHeight) << panel;
     }
   }
-  // At step 30 the stroke has only begun; at step 60 both wounds are open and the wound bed
-  // shows through them.
-  const auto p30 = pixels(run_dir() / "pictures/panels/strip_000030.png", panel_crop(0));
+  // At the first picture the stroke has only begun; at step 60 both wounds are open and the
+  // wound bed shows through them.
+  const auto p30 =
+      pixels(run_dir() / "pictures" / "panels" / ("strip_" + stem(first_) + ".png"), panel_crop(0));
   const auto p60 = pixels(run_dir() / "pictures/panels/strip_000060.png", panel_crop(0));
   const auto g60 = pixels(run_dir() / "pictures/panels/strip_000060.png", panel_crop(1));
   EXPECT_LT(wound_bed(p30), 20);
@@ -517,8 +551,12 @@ TEST(SceneRenderEarly, AFailedRenderIsRenderedAgainOnce) {
   const Json& r = s["render"];
   EXPECT_EQ(r["pictures"].size(), 2u) << r.dump(1);
   EXPECT_TRUE(r["failures"].empty()) << r.dump(1);
-  for (const char* png : {"pictures/panels/strip_000030.png", "pictures/panels/strip_000060.png"})
+  for (const auto& picture : r["pictures"]) {
+    // pictures/step_STEP.png's strip is pictures/panels/strip_STEP.png.
+    std::string png = picture.get<std::string>();
+    png.replace(png.find("step_"), 5, "panels/strip_");
     EXPECT_GT(foreground(pixels(out / png, panel_crop(0))), kWidth * kHeight / 5) << png;
+  }
   std::size_t again = 0;
   for (const auto& note : r.value("notes", Json::array()))
     again += note.get<std::string>().find("rendered again") != std::string::npos;

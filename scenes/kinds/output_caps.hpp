@@ -9,7 +9,7 @@
 namespace conform::scenes {
 
 /// Mesh files one command writes: `skin --frames`, and a scene run's frames (steps /
-/// outputs.frames_every, plus the first and the last).
+/// outputs.frames_every, plus the first and the last; twice that with outputs.vtk).
 inline constexpr long long kMaxFrames = 10000;
 /// Rows of a scene run's metrics.csv (steps / outputs.metrics_every).
 inline constexpr long long kMaxMetricRows = 1000000;

@@ -98,7 +98,8 @@ RunOutput::RunOutput(fs::path dir, const CommonSettings& common)
   if (ec)
     throw std::runtime_error("cannot create " + (dir_ / "frames").string() + ": " + ec.message());
   if (common_.render.enabled)
-    pictures_ = std::make_unique<PictureRenderer>(common_.render, dir_, common_.name);
+    pictures_ =
+        std::make_unique<PictureRenderer>(common_.render, dir_, common_.name, common_.steps);
   if (common_.render.glb) gltf_ = std::make_unique<GltfSequence>();
   if (common_.vtk) vtk_ = std::make_unique<VtkSeries>(dir_);
 }
@@ -130,17 +131,31 @@ void RunOutput::body_frame(const std::string& name, int step, const bullet::Skin
   if (vtk_) vtk_->add(name, step, step * common_.dt, body_fields(body, lips));
 }
 
-void RunOutput::picture(int step, const std::vector<PicturePanel>& panels) {
-  if (!pictures_ && !gltf_) return;
-  std::vector<FrameSnapshot> shots;
-  for (const auto& p : panels) {
-    shots.push_back(
-        snapshot(p.name, step, step * common_.dt, *p.mesh, p.lips, common_.render.scalar));
-    shots.back().caption = p.caption;
+bool RunOutput::frame_step(int step) const {
+  return (common_.frames_every > 0 && step % common_.frames_every == 0) || step == common_.steps;
+}
+
+void RunOutput::picture(int step, const std::vector<PicturePanel>& panels, bool frame_step) {
+  const auto t0 = Clock::now();
+  // Only the frames worth a picture are snapshot (their wounds tell: picture_choice.hpp).
+  bool wanted = false;
+  if (pictures_) {
+    std::vector<double> wounds;
+    for (const auto& p : panels) wounds.push_back(largest_gap(p.mesh->current, p.lips));
+    wanted = pictures_->wants(step, wounds);
   }
-  if (gltf_)
-    for (const auto& s : shots) gltf_->add(s);
-  if (pictures_) pictures_->add(std::move(shots));
+  if (wanted || (gltf_ && frame_step)) {
+    std::vector<FrameSnapshot> shots;
+    for (const auto& p : panels) {
+      shots.push_back(
+          snapshot(p.name, step, step * common_.dt, *p.mesh, p.lips, common_.render.scalar));
+      shots.back().caption = p.caption;
+    }
+    if (gltf_ && frame_step)
+      for (const auto& s : shots) gltf_->add(s);
+    if (wanted) pictures_->add(std::move(shots));
+  }
+  offer_ms_ += std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
 Json RunOutput::finish_render(Clock::time_point t0, double plots_ms, double loop_seconds,
@@ -161,6 +176,9 @@ Json RunOutput::finish_render(Clock::time_point t0, double plots_ms, double loop
   const std::size_t n = report.contains("pictures") ? report["pictures"].size() : 0;
   const double step_ms = steps > 0 ? 1e3 * loop_seconds / steps : 0.0;
   report["render_ms_total"] = pictures_ms;
+  // The snapshots offered during the loop (every step where pictures are made), part of it.
+  report["offer_ms_total"] = offer_ms_;
+  report["offer_ms_per_step"] = steps > 0 ? offer_ms_ / steps : 0.0;
   report["render_ms_per_picture"] = n > 0 ? pictures_ms / double(n) : 0.0;
   report["sim_ms_per_step"] = step_ms;
   report["render_picture_per_sim_step"] =

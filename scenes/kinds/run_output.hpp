@@ -105,8 +105,15 @@ class RunOutput {
                   const Lips* lips = nullptr);
 
   /// Offers a picture of this step: the panels side by side, rendered when the run finishes
-  /// (render_frames.hpp; a no-op with "render": false). Call it beside frame().
-  void picture(int step, const std::vector<PicturePanel>& panels);
+  /// (render_frames.hpp; a no-op with "render": false). Offer every step (offers_pictures()):
+  /// the pictures go where the wound changes. A `frame_step` (one written by frame()) is also a
+  /// frame of run.glb.
+  void picture(int step, const std::vector<PicturePanel>& panels, bool frame_step);
+  /// Whether picture() renders anything: without pictures, offering other steps than frames is
+  /// wasted work.
+  bool offers_pictures() const { return pictures_ != nullptr; }
+  /// Whether `step` is one of the run's frames (outputs.frames_every, and the last step).
+  bool frame_step(int step) const;
 
   /// Progress on stderr (progress.hpp): a bar on a terminal, plain lines otherwise.
   void progress(int step, int steps);
@@ -141,6 +148,7 @@ class RunOutput {
   std::unique_ptr<GltfSequence> gltf_;
   std::unique_ptr<VtkSeries> vtk_;
   int frames_ = 0;
+  double offer_ms_ = 0;  // in picture(): snapshots taken in the stepping loop
   std::unique_ptr<Progress> progress_;
   std::vector<std::string> failures_;
 };

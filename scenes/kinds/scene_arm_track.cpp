@@ -398,8 +398,7 @@ class ArmTrack final : public Scene {
             a->step(subs[static_cast<std::size_t>(k)], rates[static_cast<std::size_t>(k)]);
       });
       measure(r, step, out);
-      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps)
-        out.frame("arm", step, r.skin.mesh());
+      if (out.frame_step(step)) out.frame("arm", step, r.skin.mesh());
       out.progress(step, c.steps);
     }
     const double loop_s = std::chrono::duration<double>(Clock::now() - loop_start).count();

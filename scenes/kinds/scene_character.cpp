@@ -226,7 +226,7 @@ class Character final : public Scene {
       edit(body, bind, tear, compare ? &*compare : nullptr, step * c.dt, s);
       s.edit_ms += std::chrono::duration<double, std::milli>(Clock::now() - te).count();
       measure(body, seams, bind, tear, compare ? &*compare : nullptr, step, c, s, out);
-      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps)
+      if (out.frame_step(step) || (compare && out.offers_pictures()))
         write_frame(body, compare ? &*compare : nullptr, step, out);
       out.progress(step, c.steps);
     }
@@ -363,18 +363,22 @@ class Character final : public Scene {
     if (compare) compare->profiles.snapshot(step, t, compare->phys, compare->geom);
   }
 
-  // The body's frame and, with the comparison, the geometric copy's and their picture.
+  // On a frame step the body's frame and, with the comparison, the geometric copy's; with the
+  // comparison, on every step, their picture (the pictures go where the wound changes).
   static void write_frame(bullet::SkinnedSoftBody& body, const TearCompare* compare, int step,
                           RunOutput& out) {
+    const bool frame = out.frame_step(step);
     body.sync_mesh();
     const Lips lips = tear_lips(body.tear());
-    out.body_frame("character", step, body, compare ? &lips : nullptr);
+    if (frame) out.body_frame("character", step, body, compare ? &lips : nullptr);
     if (!compare) return;
-    out.frame("geometric", step, compare->geo.mesh());
+    if (frame) out.frame("geometric", step, compare->geo.mesh());
     // The physical panel is named as its frames, so run.glb keeps one sequence of the body.
-    out.picture(step, {{"character", &body.mesh(), lips, gap_caption(compare->phys)},
-                       {"geometric", &compare->geo.mesh(), tear_lips(&compare->geo.tear()),
-                        gap_caption(compare->geom)}});
+    out.picture(step,
+                {{"character", &body.mesh(), lips, gap_caption(compare->phys)},
+                 {"geometric", &compare->geo.mesh(), tear_lips(&compare->geo.tear()),
+                  gap_caption(compare->geom)}},
+                frame);
   }
 
   // metrics.physics and metrics.geometric: each opening at the end and its largest over the

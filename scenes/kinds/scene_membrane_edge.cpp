@@ -225,7 +225,7 @@ Json MembraneEdge::run(RunOutput& out) {
                           double(last.cg_iterations)};
       out.metrics().row(r);
     }
-    if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
+    if (out.frame_step(step)) {
       body.sync_mesh();
       out.body_frame("sheet", step, body);
     }

@@ -170,7 +170,7 @@ class MembranePatch final : public Scene {
                               double(r.newton_iterations)};
         out.metrics().row(row);
       }
-      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
+      if (out.frame_step(step)) {
         body.sync_mesh();
         out.body_frame("patch", step, body);
       }

@@ -121,7 +121,7 @@ class MembraneSlit final : public Scene {
         out.metrics().row(row);
       }
       if (slit && step == c.steps) last_ = r;
-      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
+      if (out.frame_step(step)) {
         body.sync_mesh();
         out.body_frame("sheet", step, body);
       }

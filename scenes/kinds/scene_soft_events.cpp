@@ -215,7 +215,7 @@ class ArmEventScene : public Scene {
         if (sever_.release) row.push_back(falling.any() ? falling.lowest() : absent);
         out.metrics().row(row);
       }
-      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
+      if (out.frame_step(step)) {
         body.sync_mesh();
         out.body_frame("arm", step, body);
       }

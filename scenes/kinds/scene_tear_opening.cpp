@@ -132,14 +132,18 @@ class TearOpening final : public Scene {
       note_solve(r, t);
       r.tear_ms += milliseconds([&] { advance_stroke(r, t); });  // edits only between steps
       r.measure_ms += milliseconds([&] { measure(r, step, t, out); });
-      if ((c.frames_every > 0 && step % c.frames_every == 0) || step == c.steps) {
+      const bool frame = out.frame_step(step);
+      if (frame || out.offers_pictures()) {
         r.body.sync_mesh();
         const Lips lips = tear_lips(r.body.tear());
-        out.body_frame("physics", step, r.body, &lips);
-        out.frame("geometric", step, r.geo.mesh());
+        if (frame) {
+          out.body_frame("physics", step, r.body, &lips);
+          out.frame("geometric", step, r.geo.mesh());
+        }
         out.picture(step,
                     {{"physics", &r.body.mesh(), lips, gap_caption(r.phys)},
-                     {"geometric", &r.geo.mesh(), tear_lips(&r.geo.tear()), gap_caption(r.geom)}});
+                     {"geometric", &r.geo.mesh(), tear_lips(&r.geo.tear()), gap_caption(r.geom)}},
+                    frame);
       }
       out.progress(step, c.steps);
     }

@@ -1,6 +1,7 @@
 #include "render/frame_snapshot.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -39,6 +40,23 @@ Eigen::Matrix2Xd vertex_uvs(const mesh::SkinnedMesh& m) {
   return uv;
 }
 
+// Calls visit(v, d) for each vertex v of either lip, d its distance to the nearest vertex of the
+// other lip (a vertex on both lips is not its own neighbour).
+template <class Visit>
+void across_lips(const Eigen::Matrix3Xd& x, const Lips& lips, Visit visit) {
+  const auto side = [&](const std::vector<std::int32_t>& from,
+                        const std::vector<std::int32_t>& to) {
+    for (const auto v : from) {
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto w : to)
+        if (w != v) best = std::min(best, (x.col(v) - x.col(w)).norm());
+      if (std::isfinite(best)) visit(v, best);
+    }
+  };
+  side(lips.left, lips.right);
+  side(lips.right, lips.left);
+}
+
 }  // namespace
 
 std::vector<double> edge_stretch(const mesh::SkinnedMesh& m) {
@@ -63,18 +81,15 @@ std::vector<double> edge_stretch(const mesh::SkinnedMesh& m) {
 
 std::vector<double> gap_width(const Eigen::Matrix3Xd& x, const Lips& lips) {
   std::vector<double> gap(static_cast<std::size_t>(x.cols()), 0.0);
-  const auto side = [&](const std::vector<std::int32_t>& from,
-                        const std::vector<std::int32_t>& to) {
-    for (const auto v : from) {
-      double best = std::numeric_limits<double>::infinity();
-      for (const auto w : to)
-        if (w != v) best = std::min(best, (x.col(v) - x.col(w)).norm());
-      if (std::isfinite(best)) gap[static_cast<std::size_t>(v)] = best;
-    }
-  };
-  side(lips.left, lips.right);
-  side(lips.right, lips.left);
+  across_lips(x, lips, [&](std::int32_t v, double d) { gap[static_cast<std::size_t>(v)] = d; });
   return gap;
+}
+
+double largest_gap(const Eigen::Matrix3Xd& x, const Lips& lips) {
+  if (lips.left.empty() || lips.right.empty()) return std::nan("");
+  double largest = 0;
+  across_lips(x, lips, [&](std::int32_t, double d) { largest = std::max(largest, d); });
+  return largest;
 }
 
 FrameSnapshot snapshot(const std::string& name, int step, double time, const mesh::SkinnedMesh& m,
@@ -94,10 +109,8 @@ FrameSnapshot snapshot(const std::string& name, int step, double time, const mes
                                 " is not in the mesh's " + std::to_string(m.vertex_count()));
       s.focus.push_back(v);
     }
-  if (scalar == "gap")
-    s.scalar = gap_width(s.positions, lips);
-  else
-    s.scalar = edge_stretch(m);
+  s.wound = largest_gap(s.positions, lips);
+  s.scalar = scalar == "gap" ? gap_width(s.positions, lips) : edge_stretch(m);
   return s;
 }
 

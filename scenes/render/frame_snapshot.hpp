@@ -10,6 +10,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -30,6 +31,7 @@ struct FrameSnapshot {
   std::vector<double> scalar;       // #V
   std::vector<std::int32_t> focus;  // the event's vertices (both lips), may be empty
   std::string caption;              // under the panel in the picture, e.g. its largest gap
+  double wound = std::nan("");      // the largest gap across the lips, m; NaN without lips
 };
 
 /// The lips of a wound or cut, as vertex ids of the mesh.
@@ -46,5 +48,8 @@ std::vector<double> edge_stretch(const mesh::SkinnedMesh& mesh);
 
 /// Per-vertex gap width: for a lip vertex the distance to the nearest vertex of the other lip.
 std::vector<double> gap_width(const Eigen::Matrix3Xd& positions, const Lips& lips);
+
+/// The largest gap width over the lips' vertices (FrameSnapshot::wound); NaN without two lips.
+double largest_gap(const Eigen::Matrix3Xd& positions, const Lips& lips);
 
 }  // namespace conform::scenes

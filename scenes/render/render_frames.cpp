@@ -63,10 +63,12 @@ bool have_tool(const std::string& tool) {
   return false;
 }
 
-PictureRenderer::PictureRenderer(RenderSettings settings, fs::path dir, std::string title)
+PictureRenderer::PictureRenderer(RenderSettings settings, fs::path dir, std::string title,
+                                 int run_steps)
     : settings_(std::move(settings)),
       dir_(std::move(dir)),
       title_(std::move(title)),
+      run_steps_(run_steps),
       have_f3d_(have_tool("f3d")) {
   // Without a display of our own, a virtual one starts now, while the scene simulates.
   const char* own = std::getenv("DISPLAY");
@@ -75,14 +77,45 @@ PictureRenderer::PictureRenderer(RenderSettings settings, fs::path dir, std::str
                                                 std::max(settings_.height, 1024));
 }
 
-void PictureRenderer::add(std::vector<FrameSnapshot> panels) {
-  if (panels.empty()) return;
-  if (frames_.empty() && have_f3d_) prestart(panels.size());
-  frames_.push_back(std::move(panels));
+namespace {
+
+// What one offered frame holds, bytes: positions, normals, UVs, the scalar and the faces.
+std::size_t frame_bytes(const std::vector<FrameSnapshot>& panels) {
+  std::size_t bytes = 0;
+  for (const auto& p : panels)
+    bytes += sizeof(double) * (9 * static_cast<std::size_t>(p.positions.cols())) +
+             sizeof(mesh::Face) * p.faces.size();
+  return std::max<std::size_t>(bytes, 1);
 }
 
-// The renders of the last frame start now, with the first frame: f3d starts up while the scene
-// simulates (f3d_render.hpp). The last frame is expected to have as many panels as the first.
+}  // namespace
+
+bool PictureRenderer::wants(int step, const std::vector<double>& wounds) {
+  // The last frame's renders start with the first frame offered: f3d starts up while the scene
+  // simulates (f3d_render.hpp). Every frame is expected to have as many panels as the first.
+  if (!prestart_tried_ && have_f3d_ && !wounds.empty()) prestart(wounds.size());
+  prestart_tried_ = true;
+  // One picture is the last frame's: no other frame is worth a snapshot.
+  if (step >= run_steps_) return true;
+  return settings_.pictures > 1 && candidates_.worth_offering(step, wounds, run_steps_);
+}
+
+void PictureRenderer::add(std::vector<FrameSnapshot> panels) {
+  if (panels.empty()) return;
+  if (candidates_.empty()) {
+    // Enough candidates to spread the pictures where the wound changes, within 256 MiB.
+    const std::size_t wanted = std::clamp<std::size_t>(8 * settings_.pictures, 16, 128);
+    const std::size_t fit =
+        std::max<std::size_t>(8, (std::size_t(256) << 20) / frame_bytes(panels));
+    candidates_ = PictureCandidates(std::min(wanted, fit));
+    if (!prestart_tried_ && have_f3d_) prestart(panels.size());
+    prestart_tried_ = true;
+  }
+  ++offered_;
+  candidates_.add(std::move(panels));
+}
+
+// The renders of the last frame start now, while the scene simulates (f3d_render.hpp).
 void PictureRenderer::prestart(std::size_t panels) {
   const fs::path dir = dir_ / "pictures" / "panels";
   std::error_code ec;
@@ -97,16 +130,6 @@ void PictureRenderer::prestart(std::size_t panels) {
     prestarted_.push_back(std::make_unique<PrestartedRender>(
         dir, "last_" + std::to_string(k), settings_.width * (one ? 1 : n), settings_.height, angle,
         display_.get()));
-}
-
-// At most `pictures` frames: the last one and the others evenly spaced before it.
-std::vector<std::size_t> PictureRenderer::chosen() const {
-  const std::size_t m = frames_.size(), n = std::min<std::size_t>(m, settings_.pictures);
-  std::vector<std::size_t> out;
-  for (std::size_t k = 0; k < n; ++k)
-    out.push_back(n == 1 ? m - 1 : (m - 1) - (n - 1 - k) * (m - 1) / (n - 1));
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
 }
 
 namespace {
@@ -345,13 +368,21 @@ void PictureRenderer::start() {
   started_ = true;
   pending_ = std::make_unique<Pending>();
   Pending& p = *pending_;
-  if (frames_.empty()) return;
+  if (candidates_.empty()) return;
   if (!have_f3d_) {
     warn(p.report,
          "f3d is not installed (scripts/deps.sh installs f3d, xvfb, ffmpeg): no pictures");
     return;
   }
-  for (const auto i : chosen()) p.frames.push_back(frames_[i]);
+  // Where the wound changes (picture_choice.hpp): the span, in summary.json's render.chosen.
+  const PictureChoice choice = candidates_.choose(static_cast<std::size_t>(settings_.pictures));
+  const auto& kept = candidates_.frames();
+  for (const auto i : choice.frames) p.frames.push_back(kept[i]);
+  p.report["chosen"] = {{"by", choice.by_wound ? "wound" : "even"},
+                        {"from_step", kept[choice.from].front().step},
+                        {"settled_step", kept[choice.settled].front().step},
+                        {"offered", offered_},
+                        {"kept", kept.size()}};
   std::vector<double> values;
   for (const auto& f : p.frames)
     for (const auto& panel : f)

@@ -28,6 +28,7 @@
 #include "base/scene_config.hpp"
 #include "render/f3d_render.hpp"
 #include "render/frame_snapshot.hpp"
+#include "render/picture_choice.hpp"
 #include "render/render_settings.hpp"
 #include "render/virtual_display.hpp"
 
@@ -35,11 +36,18 @@ namespace conform::scenes {
 
 class PictureRenderer {
  public:
-  PictureRenderer(RenderSettings settings, std::filesystem::path dir, std::string title);
+  /// A run of `run_steps` steps: its pictures go in `dir`/pictures.
+  PictureRenderer(RenderSettings settings, std::filesystem::path dir, std::string title,
+                  int run_steps);
 
-  /// Offers one frame: its panels, left to right (e.g. physics, geometric).
+  /// Offers one frame: its panels, left to right (e.g. physics, geometric). Any step may be
+  /// offered; the frames kept are those where the wound changes (picture_choice.hpp). Every
+  /// frame must have as many panels as the first.
   void add(std::vector<FrameSnapshot> panels);
-  std::size_t offered() const { return frames_.size(); }
+  std::size_t offered() const { return offered_; }
+  /// Whether a frame of `step` whose panels' wounds (FrameSnapshot::wound) are these is worth
+  /// offering (PictureCandidates::worth_offering); the run's last step always is.
+  bool wants(int step, const std::vector<double>& wounds);
 
   /// Starts rendering the chosen frames (f3d runs in the background).
   void start();
@@ -53,7 +61,6 @@ class PictureRenderer {
   ~PictureRenderer();
 
  private:
-  std::vector<std::size_t> chosen() const;
   void prestart(std::size_t panels);
   struct Pending;  // a render under way
   struct Input;    // one render's surface
@@ -66,7 +73,10 @@ class PictureRenderer {
   RenderSettings settings_;
   std::filesystem::path dir_;
   std::string title_;
-  std::vector<std::vector<FrameSnapshot>> frames_;
+  PictureCandidates candidates_{16};
+  std::size_t offered_ = 0;
+  int run_steps_ = 0;
+  bool prestart_tried_ = false;
   std::unique_ptr<Pending> pending_;
   bool have_f3d_ = false;
   std::unique_ptr<VirtualDisplay> display_;  // when conform has no display of its own

@@ -29,7 +29,7 @@ struct RenderCamera {
 struct RenderSettings {
   bool enabled = true;             // pictures and video
   bool glb = true;                 // run.glb, the whole sequence
-  int pictures = 1;                // the most pictures (the last one and evenly before it)
+  int pictures = 1;                // the most pictures: where the wound changes (picture_choice.hpp)
   int width = 640, height = 480;   // one panel, pixels
   std::string scalar = "stretch";  // "stretch" (edge strain) or "gap" (width across the lips)
   std::string video = "gif";       // "gif", "mp4" or "none"
