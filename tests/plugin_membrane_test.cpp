@@ -9,6 +9,7 @@
 
 #include "conform/bullet/plugin.hpp"
 #include "conform/membrane/slit_sheet.hpp"
+#include "conform/membrane/solver.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "plugin_world.hpp"
 

@@ -52,7 +52,7 @@
 #include "conform/bullet/piece.hpp"
 #include "conform/cga/plane.hpp"
 #include "conform/membrane/skin_material.hpp"
-#include "conform/membrane/solver.hpp"
+#include "conform/membrane/solver_settings.hpp"
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/drill.hpp"
 #include "conform/mesh/skinned_mesh.hpp"

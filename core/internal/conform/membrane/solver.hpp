@@ -36,50 +36,9 @@
 #include <vector>
 
 #include "conform/membrane/model.hpp"
+#include "conform/membrane/solver_settings.hpp"
 
 namespace conform::membrane {
-
-/// How each Newton system's conjugate gradients are preconditioned.
-enum class Preconditioner {
-  /// M = D (the 3 x 3 diagonal blocks).
-  block_jacobi,
-  /// Symmetric block Gauss-Seidel, M = (D + L) D^-1 (D + L)^T, applied by Eisenstat's trick
-  /// (one triangular sweep each way per iteration, about the cost of one Jacobi iteration):
-  /// about half the iterations of block_jacobi on the skin's systems (plugin_bench).
-  symmetric_gauss_seidel,
-};
-
-struct SolverSettings {
-  /// Stop when the largest |nodal force| / (node area x S) over the free nodes is below this,
-  /// where S is the material's stress scale (SkinMaterial::stress_scale: the larger pre-stress,
-  /// or E without one). Dimensionless, so the same setting means the same accuracy at every
-  /// stress level. The default, 1.2e-3 (97 Pa for skin's 80.8 kPa pre-stress), is converged for
-  /// the tear-opening wound: 4x tighter changes its largest opening by 0.007 % (res 1) and
-  /// 0.007 % (res 2), 4x looser by 0.27 % / 0.07 % (measured at 100 Pa).
-  double relative_tolerance = 1.2e-3;
-  int max_newton_iterations = 40;
-  int max_cg_iterations = 400;
-  /// Each Newton system is solved until its residual is below this fraction of the gradient.
-  double cg_relative_tolerance = 0.05;
-  Preconditioner preconditioner = Preconditioner::symmetric_gauss_seidel;
-  /// A Newton step moves only the free nodes near one whose residual exceeds
-  /// max(relative_tolerance x S, local_fraction x the largest residual): after an edit the
-  /// imbalance is local, and the rest of the mesh is already in balance to far better than it. In
-  /// [0, 1); 0 moves every free node in every step. The stopping test is global either way.
-  double local_fraction = 1e-2;
-  /// ... where near is within local_reach decay lengths sqrt(E t / k_t) of the attachment
-  /// (the distance over which it screens a load: about 4 cm for the default skin), > 0.
-  double local_reach = 2;
-  /// Solve each symmetric_gauss_seidel system on a packed copy of its active rows (contiguous
-  /// memory, the same step bit for bit). false: in place over the whole mesh's arrays (the
-  /// solver before; the benchmarks' baseline).
-  bool packed_systems = true;
-  /// OpenMP threads for the element and node loops of large meshes (1: serial). The results do
-  /// not depend on it (every sum is gathered per vertex in a fixed order).
-  int threads = 1;
-  /// Throws std::invalid_argument naming a field out of its range.
-  void validate() const;
-};
 
 /// A 3 x 0 matrix that outlives every StepInput (the default of its optional fields).
 inline const Eigen::Matrix3Xd& no_columns() {
@@ -111,15 +70,6 @@ struct StepInput {
   /// here, e.g. the last solution moved with the targets, which is the better start for a body
   /// at rest against gravity (the prediction is dt^2 g off there).
   Eigen::Ref<const Eigen::Matrix3Xd> alternative_guess = no_columns();
-};
-
-struct SolveReport {
-  double initial_residual = 0;   // Pa, before the first Newton step
-  double residual = 0;           // Pa, at the returned positions
-  double relative_residual = 0;  // residual / S, the stopping test's measure (dimensionless)
-  int newton_iterations = 0;
-  int cg_iterations = 0;  // summed over the Newton iterations
-  bool converged = false;
 };
 
 class Solver {
