@@ -147,7 +147,7 @@ class Tear {
   const std::string& message() const { return message_; }
 
  private:
-  friend class TearAdvance;  // the steps of advance() after the start (tear.cpp)
+  friend struct TearState;  // what the steps of advance() after the start use (tear_step.hpp)
   struct PathVertex {
     std::int32_t right = -1;  // the original vertex (faces right of the path)
     std::int32_t left = -1;   // its duplicate for the faces on the left, −1 at the ends
