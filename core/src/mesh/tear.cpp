@@ -87,8 +87,8 @@ Tear::Tear(SkinnedMesh& mesh, Adjacency& adjacency, const TearOptions& options)
         "tear: snap_fraction must be in (0, 0.25) and min_angle in [0, 0.5)");
   if (!(options.sweep_tolerance >= 0))
     throw std::invalid_argument("tear: sweep_tolerance must be ≥ 0 (infinity: unbounded)");
-  // The walk and the splits measure positions: a NaN makes its crossings meaningless (the fuzzer
-  // found a tear on such a mesh leaving a non-manifold vertex).
+  // The walk and the splits measure positions: a NaN makes its crossings meaningless, and the
+  // splits could then leave a non-manifold vertex.
   if (!mesh.current.allFinite() || !mesh.rest.allFinite())
     throw std::invalid_argument("tear: the mesh has non-finite positions");
 }

@@ -123,7 +123,7 @@ class StepPlane {
   double mean_edge(std::int32_t face) const;
   // A face whose corners, split once more, keep the sliver floor (smallest angle ≥ 2 min_angle):
   // in a thinner face (a real model's) the halves would be split again below the bound of the
-  // face they lie in (mesh_real_models_test found one without this check).
+  // face they lie in.
   bool roomy(std::int32_t face) const {
     const Face& f = mesh_.faces[static_cast<std::size_t>(face)];
     return smallest_angle(mesh_.current.col(f[0]), mesh_.current.col(f[1]),
