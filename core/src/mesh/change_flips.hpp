@@ -1,4 +1,4 @@
-// Edge flips beside a topology change (the tear's lips, issue 18): Lawson's flips for the
+// Edge flips beside a topology change (the tear's lips): Lawson's flips for the
 // smallest angle among the faces a TopologyChange adds and the mesh faces next to them, made
 // part of the change itself (flipped mesh faces become removed and added faces).
 //

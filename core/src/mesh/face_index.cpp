@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "conform/mesh/adjacency.hpp"
+#include "face_index_box.hpp"
 
 namespace conform::mesh {
 
@@ -21,131 +22,14 @@ void reserve_more(std::vector<T>& v, std::size_t more) {
   if (need > v.capacity()) v.reserve(std::max(need, v.capacity() + v.capacity() / 2));
 }
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-
-bool less_hit(const SegmentHit& a, const SegmentHit& b) {
-  return a.t < b.t || (a.t == b.t && a.face < b.face);
-}
-
 }  // namespace
 
-bool segment_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& q, const Eigen::Vector3d& a,
-                      const Eigen::Vector3d& b, const Eigen::Vector3d& c, double& t,
-                      std::array<double, 3>& bary) {
-  const Eigen::Vector3d d = q - p, e1 = b - a, e2 = c - a;
-  const Eigen::Vector3d h = d.cross(e2);
-  const double det = e1.dot(h);
-  if (!(std::abs(det) > 1e-300)) return false;
-  const double inv = 1 / det;
-  const Eigen::Vector3d s = p - a;
-  const double u = inv * s.dot(h);
-  if (u < 0 || u > 1) return false;
-  const Eigen::Vector3d qv = s.cross(e1);
-  const double v = inv * d.dot(qv);
-  if (v < 0 || u + v > 1) return false;
-  const double tt = inv * e2.dot(qv);
-  if (tt < 0 || tt > 1) return false;
-  t = tt;
-  bary = {1 - u - v, u, v};
-  return true;
-}
-
-std::vector<SegmentHit> scan_segment_hits(const SkinnedMesh& mesh, const Eigen::Vector3d& p,
-                                          const Eigen::Vector3d& q) {
-  std::vector<SegmentHit> out;
-  for (std::int32_t f = 0; f < mesh.face_count(); ++f) {
-    const Face& t = mesh.faces[static_cast<std::size_t>(f)];
-    SegmentHit h{f};
-    if (segment_triangle(p, q, mesh.current.col(t[0]), mesh.current.col(t[1]),
-                         mesh.current.col(t[2]), h.t, h.bary))
-      out.push_back(h);
-  }
-  std::sort(out.begin(), out.end(), less_hit);
-  return out;
-}
-
-namespace {
-
-// A box from double bounds, padded by 1e−6 of its largest extent plus its largest coordinate:
-// more than a float's rounding (2^−24 relative), so the float box still holds the doubles, and
-// enough that rounding in the slab test never rejects a point of a face.
-template <class Box>
-Box make_box(const double lo[3], const double hi[3]) {
-  Box b;
-  if (!(lo[0] <= hi[0])) {  // empty (or NaN)
-    for (int k = 0; k < 3; ++k) b.lo[k] = kInf, b.hi[k] = -kInf;
-    return b;
-  }
-  double ext = 0, mag = 0;
-  for (int k = 0; k < 3; ++k) {
-    ext = std::max(ext, hi[k] - lo[k]);
-    mag = std::max({mag, std::abs(lo[k]), std::abs(hi[k])});
-  }
-  const double pad = 1e-6 * (ext + mag);
-  for (int k = 0; k < 3; ++k) {
-    b.lo[k] = static_cast<float>(lo[k] - pad);
-    b.hi[k] = static_cast<float>(hi[k] + pad);
-  }
-  return b;
-}
-
-template <class Box>
-void grow(Box& b, const Box& o) {
-  for (int k = 0; k < 3; ++k) {
-    b.lo[k] = std::min(b.lo[k], o.lo[k]);
-    b.hi[k] = std::max(b.hi[k], o.hi[k]);
-  }
-}
-
-template <class Box>
-bool empty(const Box& b) {
-  return !(b.lo[0] <= b.hi[0]);
-}
-
-template <class Box>
-double area(const Box& b) {
-  if (empty(b)) return 0;
-  const double x = double(b.hi[0]) - b.lo[0], y = double(b.hi[1]) - b.lo[1],
-               z = double(b.hi[2]) - b.lo[2];
-  return 2 * (x * y + y * z + z * x);
-}
-
-template <class Box>
-bool contains(const Box& outer, const Box& inner) {
-  if (empty(inner)) return true;
-  for (int k = 0; k < 3; ++k)
-    if (inner.lo[k] < outer.lo[k] || inner.hi[k] > outer.hi[k]) return false;
-  return true;
-}
-
-// The segment p + t d, t in [0, tmax], against a box; on a hit, the parameter where it enters.
-struct Ray {
-  Eigen::Vector3d p, d, inv;
-  Ray(const Eigen::Vector3d& a, const Eigen::Vector3d& b) : p(a), d(b - a) {
-    for (int k = 0; k < 3; ++k) inv[k] = d[k] != 0 ? 1 / d[k] : 0;
-  }
-  template <class Box>
-  bool hits(const Box& b, double tmax, double& enter) const {
-    if (empty(b)) return false;
-    double t0 = 0, t1 = tmax;
-    for (int k = 0; k < 3; ++k) {
-      const double lo = b.lo[k], hi = b.hi[k];
-      if (d[k] == 0) {
-        if (p[k] < lo || p[k] > hi) return false;
-        continue;
-      }
-      double ta = (lo - p[k]) * inv[k], tb = (hi - p[k]) * inv[k];
-      if (ta > tb) std::swap(ta, tb);
-      t0 = std::max(t0, ta);
-      t1 = std::min(t1, tb);
-      if (t0 > t1) return false;
-    }
-    enter = t0;
-    return true;
-  }
-};
-
-}  // namespace
+using boxes::area;
+using boxes::contains;
+using boxes::empty;
+using boxes::grow;
+using boxes::kInf;
+using boxes::make_box;
 
 FaceIndex::Box FaceIndex::face_box(const SkinnedMesh& mesh, std::int32_t f) const {
   const Face& t = mesh.faces[static_cast<std::size_t>(f)];
@@ -605,90 +489,6 @@ int FaceIndex::depth() const {
     deepest = std::max(deepest, d[i]);
   }
   return deepest;
-}
-
-void FaceIndex::segment_hits(const SkinnedMesh& mesh, const Eigen::Vector3d& p,
-                             const Eigen::Vector3d& q, std::vector<SegmentHit>& out) const {
-  out.clear();
-  if (nodes_.empty()) return;
-  const Ray ray(p, q);
-  std::vector<std::int32_t> stack;
-  stack.reserve(64);
-  stack.push_back(0);
-  while (!stack.empty()) {
-    const Node& n = nodes_[static_cast<std::size_t>(stack.back())];
-    stack.pop_back();
-    double enter = 0;
-    if (!ray.hits(n.box, 1.0, enter)) continue;
-    if (n.child >= 0) {
-      stack.push_back(n.child + 1);
-      stack.push_back(n.child);
-      continue;
-    }
-    for (std::int32_t i = 0; i < n.count; ++i) {
-      const std::int32_t f = items_[static_cast<std::size_t>(n.first + i)];
-      const Face& t = mesh.faces[static_cast<std::size_t>(f)];
-      SegmentHit h{f};
-      if (segment_triangle(p, q, mesh.current.col(t[0]), mesh.current.col(t[1]),
-                           mesh.current.col(t[2]), h.t, h.bary))
-        out.push_back(h);
-    }
-  }
-  std::sort(out.begin(), out.end(), less_hit);
-}
-
-SegmentHit FaceIndex::first_hit(const SkinnedMesh& mesh, const Eigen::Vector3d& p,
-                                const Eigen::Vector3d& q) const {
-  SegmentHit best;
-  if (nodes_.empty()) return best;
-  const Ray ray(p, q);
-  double tmax = 1;
-  struct Entry {
-    std::int32_t node;
-    double enter;
-  };
-  std::vector<Entry> stack;
-  stack.reserve(64);
-  double enter = 0;
-  if (ray.hits(nodes_[0].box, tmax, enter)) stack.push_back({0, enter});
-  while (!stack.empty()) {
-    const Entry e = stack.back();
-    stack.pop_back();
-    if (e.enter > tmax) continue;
-    const Node& n = nodes_[static_cast<std::size_t>(e.node)];
-    if (n.child >= 0) {
-      double t0 = 0, t1 = 0;
-      const bool h0 = ray.hits(nodes_[static_cast<std::size_t>(n.child)].box, tmax, t0);
-      const bool h1 = ray.hits(nodes_[static_cast<std::size_t>(n.child + 1)].box, tmax, t1);
-      // The nearer child is popped first.
-      if (h0 && h1) {
-        if (t0 <= t1) {
-          stack.push_back({n.child + 1, t1});
-          stack.push_back({n.child, t0});
-        } else {
-          stack.push_back({n.child, t0});
-          stack.push_back({n.child + 1, t1});
-        }
-      } else if (h0) {
-        stack.push_back({n.child, t0});
-      } else if (h1) {
-        stack.push_back({n.child + 1, t1});
-      }
-      continue;
-    }
-    for (std::int32_t i = 0; i < n.count; ++i) {
-      const std::int32_t f = items_[static_cast<std::size_t>(n.first + i)];
-      const Face& t = mesh.faces[static_cast<std::size_t>(f)];
-      SegmentHit h{f};
-      if (segment_triangle(p, q, mesh.current.col(t[0]), mesh.current.col(t[1]),
-                           mesh.current.col(t[2]), h.t, h.bary) &&
-          (best.face < 0 || less_hit(h, best))) {
-        best = h;
-        tmax = h.t;
-      }
-    }
-  }
-  return best;
 }
 
 std::string FaceIndex::validate(const SkinnedMesh& mesh) const {

@@ -4,36 +4,24 @@
 // loop but not inside one of its holes, inside an island within a hole, and so on — so a
 // hollow tube cut across gives a ring, and loops side by side give separate discs. Loops are
 // polygons in the plane, each vertex listed once, in any orientation; they must not cross or
-// touch one another or themselves.
+// touch one another or themselves. Neither triangulator adds vertices: every triangle joins
+// three loop vertices, and the result is the constrained Delaunay triangulation.
 //
 // Two triangulators:
-//   ConstrainedDelaunay  CGAL's 2D constrained Delaunay triangulation of every loop edge
-//                        (exact predicates), faces kept by nesting parity (a walk from the
-//                        infinite face that flips parity across each loop edge). Available
-//                        when Conform was built with CGAL (libcgal-dev; an optional
-//                        dependency, see has_cgal_triangulator()). CGAL gets the loops'
-//                        corners, centred and sheared by 2^-32 (orientations kept, exact
-//                        cocircular ties broken): flat vertices (collinear with their
-//                        neighbours, every other vertex of a cut across split quads) and
-//                        symmetric sections otherwise send its filters to exact arithmetic.
-//                        The flat vertices are put back by splitting the triangle on their
-//                        edge, then Lawson's flips (as below) restore constrained Delaunay.
-//   EarClipping          nesting depths by point-in-polygon tests, each hole joined to the
-//                        loop around it by a bridge to a vertex it sees; a convex polygon is
-//                        triangulated as a strip taking the Delaunay diagonal at each step,
-//                        any other by ear clipping (a linked list, only reflex vertices
-//                        tested); then Lawson's flips of the inner edges to the constrained
-//                        Delaunay triangulation (floating-point predicates with a tolerance).
-//                        Always available; the fallback, and faster than CGAL's on the cut's
-//                        small sections.
-// Neither adds vertices: every triangle joins three loop vertices.
+//   ConstrainedDelaunay  CGAL's, with exact predicates, faces kept by nesting parity; only when
+//                        Conform was built with CGAL (has_cgal_triangulator()). The loops are
+//                        sheared by 2^-32 first, so that flat vertices and symmetric sections do
+//                        not send its filters to exact arithmetic; the flat vertices are then put
+//                        back by splits and Lawson's flips.
+//   EarClipping          holes bridged to the loop around them, then a Delaunay strip (convex
+//                        polygons) or ear clipping, then Lawson's flips (floating-point
+//                        predicates with a tolerance). Always available; the fallback, and
+//                        faster than CGAL's on the cut's small sections.
 //
-// Forbidden diagonals: pairs of loop vertices that the triangulation must not join (a cut
-// passes them in: an edge of the mesh that lies in the plane between two loop vertices, with
-// its faces on one side, is a diagonal of the section, and a cap triangle on it would give that
-// edge a third and fourth face). When the first triangulation uses one, the section is
-// triangulated again by ear clipping that clips no ear whose diagonal is forbidden and flips
-// no edge into one; if that fails too, a problem is reported.
+// Forbidden diagonals: pairs of loop vertices that the triangulation must not join (an edge of
+// the mesh lying in the plane with its faces on one side: a cap triangle on it would give that
+// edge a third face). When the first triangulation uses one, the section is triangulated again
+// by ear clipping that avoids them; if that fails too, a problem is reported.
 #pragma once
 
 #include <Eigen/Core>

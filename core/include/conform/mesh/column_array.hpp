@@ -1,12 +1,11 @@
 // Per-vertex columns with spare capacity, for the fields of SkinnedMesh.
 //
-// Every topology change appends vertices. Eigen's Matrix has no capacity, so its
-// conservativeResize reallocates and copies every column each time: O(#V) per change, 36 MB
-// copied per change at 500k faces. ColumnArray is an Eigen::Map (so every Eigen expression,
-// col(), row(), operator(), data(), setZero(), … works on it as on a matrix) over storage that
-// grows geometrically (×1.5), so appending k columns costs amortized O(k); a copy or an
-// assignment leaves room for about 1/8 more columns, so that the first changes to a copied or
-// imported mesh do not copy it again.
+// Every topology change appends vertices, and Eigen's Matrix has no capacity: its
+// conservativeResize copies every column each time, O(#V) per change. ColumnArray is an
+// Eigen::Map (so every Eigen expression, col(), row(), operator(), data(), setZero(), … works on
+// it as on a matrix) over storage that grows geometrically (×1.5), so appending k columns costs
+// amortized O(k); a copy or an assignment leaves room for about 1/8 more columns, so that the
+// first changes to a copied or imported mesh do not copy it again.
 //
 // Differences from Eigen::Matrix: assignment and resize() change the size (and keep the
 // spare capacity); new columns after resize() or conservativeResize() are unspecified, as in

@@ -1,34 +1,26 @@
 // A bounding volume hierarchy over the faces of a mesh, on its CURRENT positions, answering
 // segment queries (the scalpel's blade, the drill's axis) in O(log F + hits) instead of a scan
-// of every face.
+// of every face. Queries are exact provided the boxes were fitted to the current positions:
+// boxes are floats padded by more than their rounding, and the final test is the exact (double)
+// segment–triangle test.
 //
-// Why a BVH and not a uniform grid: the meshes it serves are far from uniform (the arm's
-// rounded caps and the drill's refinement near its rims make faces of very different sizes,
-// a sheet is flat, a sphere is hollow), and they move every step. A BVH adapts to the face sizes,
-// its refit after a motion is one bottom-up pass that never changes its structure (a grid has to
-// re-bin every face, and its cell size and extent go stale as the mesh moves or deforms), and
-// faces can be inserted and removed locally. Leaves hold up to 8 faces (4 after a build); boxes
-// are floats padded by more than their rounding, so a box test never rejects a face that the
-// exact (double) segment–triangle test accepts.
+// Why a BVH: the meshes are far from uniform (rounded caps, refinement near a drill's rims) and
+// move every step; a refit is one bottom-up pass that keeps the structure, and faces can be
+// inserted and removed locally, where a grid would re-bin every face. Leaves hold up to 8 faces.
 //
 // Keeping the index in sync (the caller's duty, except where noted):
 //   - build(mesh) once per mesh state (O(F log F));
 //   - whenever the current positions move (skinning, simulation, Tear::open): refit(mesh)
 //     (O(F), structure kept), or mark_moved() to have the next operation refit before it
-//     queries (ensure_fitted); the plugin moves every vertex every step, so marking is the
-//     cheap choice there: the refit is then paid only when a tear starts or a drill runs;
+//     queries (ensure_fitted); the plugin marks, so the refit is paid only when a tear starts
+//     or a drill runs;
 //   - after every TopologyChange applied to the mesh: update(mesh, change), with the mesh
 //     already changed (O(changed faces · depth)). Tear and drill given an index do this
-//     themselves for every change they apply; a cut (or any other change) applied by the
-//     caller must be followed by update() as well. Added faces near the faces they replace
-//     enter one by one; when more than 16 others come in one change (the drill's tube walls
-//     and rings, inside the limb and away from every surface leaf), they are built into one
-//     subtree (as build() does) hung at the leaf where their box grows the tree least, rather
-//     than each descending the whole tree (faster, and the tree stays far shallower);
+//     themselves; a cut (or any other change) applied by the caller must be followed by
+//     update() as well. More than 16 faces added away from the ones they replace (a drill's
+//     tube walls) are built into one subtree, so the tree stays shallow;
 //   - boxes only grow under update(): after many changes, refit() tightens them and build()
 //     restores a balanced tree.
-// Queries use the faces' exact positions at query time for the final test, and the boxes to
-// prune: they are exact provided the boxes were fitted to the current positions.
 #pragma once
 
 #include <Eigen/Core>

@@ -3,20 +3,14 @@
 // body. The caller (the Bullet plugin) keeps the faces, each vertex's face list and the body
 // each vertex belonged to before the change; this is plain mesh work over those arrays.
 //
-// A piece can only split where faces changed, so one search starts at every changed vertex;
-// searches that meet merge into a group, and they advance in turn, one vertex each, until at
-// most one group is still growing. The exhausted groups are complete pieces (no larger than
-// the growing one, up to the turn order); the growing one is the rest of its body, which keeps
-// that body unexplored (the open group). Only if that group reaches vertices of two bodies (a
-// merge) or of none is it explored to the end.
-//
-// A shorter proof that nothing split ends changes inside one body (a drill through both walls
-// of the arm, whose two holes' searches would only meet by growing around it): the body was
-// connected, and an old path can only have used removed faces within one cluster of them
-// (removed faces sharing vertices), entering and leaving at vertices of that cluster that keep
-// faces. Once each cluster's surviving vertices are in one group, every old vertex that keeps
-// faces is still connected to all others: the groups holding one are the body (the open
-// group), and a group of new vertices only is a piece of its own once exhausted.
+// How: a piece can only split where faces changed, so one search starts at every changed
+// vertex; searches that meet merge into a group, and they advance in turn, one vertex each,
+// until at most one group is still growing. The exhausted groups are complete pieces; the
+// growing one is the rest of its body, left unexplored (the open group), unless it reaches
+// vertices of two bodies (a merge) or of none. A shorter proof ends changes inside one body
+// (a drill through both walls of a limb): an old path can only have used removed faces within
+// one cluster of them, so once each cluster's surviving vertices are in one group, every old
+// vertex that keeps faces is still connected to all others.
 #pragma once
 
 #include <cstdint>

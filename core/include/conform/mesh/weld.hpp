@@ -4,12 +4,10 @@
 //
 // The rule.
 // - Two vertices are at one position when their rest positions are within
-//   `tolerance` × the diagonal of the rest positions' bounding box (default 1e-7), and they are
-//   in the same group (the io layer welds each mesh of a file on its own: a mesh's vertices
-//   share one space, and MeshInfo's vertex ranges stay contiguous). Measured on the rigged
-//   assimp-testmodels: 1e-7 and below weld exactly the bit-equal seam copies; 3e-7 and 1e-6
-//   also weld distinct nearby vertices of X/Testwuson.X and SMD/WusonSMD.smd (10 and 14 edges
-//   then used by more than two faces).
+//   `tolerance` × the diagonal of the rest positions' bounding box (default 1e-7: it welds the
+//   bit-equal seam copies and no distinct nearby vertices), and they are in the same group (the
+//   io layer welds each mesh of a file on its own: a mesh's vertices share one space, and
+//   MeshInfo's vertex ranges stay contiguous).
 // - Bone weights. Coincident vertices whose (up to 4) influences agree (the largest difference
 //   of one bone's weight is at most `weight_tolerance`, default 1e-3) weld as they are: the
 //   kept vertex's influences. Where they differ (a file whose seam copies were weighted
@@ -20,14 +18,12 @@
 //     Each copy then skins to the mean of where the file puts the copies (to first order).
 //   - `keep_apart`: they stay apart, each skinning exactly as in the file (the seam opens as
 //     they deform).
-//   Measured: X/Testwuson.X has 7 such copies of its 2124 vertices (kept apart they part by
-//   0.38 % of its diagonal in the character scene), X/BCN_Epileptic.X 1; the other rigged
-//   models none (mesh_weld_test.cpp).
 // - Greedy and deterministic: vertices are visited in index order and each joins the first
 //   (lowest-index) kept vertex it matches, else is kept itself. Kept vertices keep their
 //   relative order; a kept vertex keeps its own rest and current position, influences and UV;
 //   its per-vertex normal becomes the renormalized sum of its cluster's normals.
 // - Faces whose corners weld together (collapsed to a line or point) are dropped.
+// Measurements on the test models: docs/notes/mesh_edits.md.
 #pragma once
 
 #include <cstdint>
