@@ -3,7 +3,7 @@
 // up to rounding), lands on a rigid box and stays outside it (no node more than 1 mm inside),
 // and with Bullet's volume constraint keeps its volume instead of crushing flat.
 //
-// Collision findings (measured here, see README): Bullet's soft-rigid contacts (SDF_RS) sample
+// Collision findings (measured here, see docs/library.md): Bullet's soft-rigid contacts (SDF_RS) sample
 // the rigid shape on a sparse signed-distance grid; at its default voxel size (0.25 m) the
 // grid is far coarser than a 5 cm piece, and the nodes sink into the box; at 0.025 m they do
 // not. A btStaticPlaneShape ground is not convex, the sparse SDF has no distance for it, and
@@ -222,7 +222,7 @@ TEST(PluginRelease, AnInnerPressureHoldsThePieceUp) {
 }
 
 TEST(PluginRelease, BulletsDefaultVoxelAndAPlaneGroundDoNotHold) {
-  // Figures for the README (printed); the assertions pin the direction of each finding.
+  // Figures for docs/library.md (printed); the assertions pin the direction of each finding.
   bullet::ReleaseOptions keep{};
   keep.volume_modulus = kModulus;
   const Landing coarse = land(0.25, keep, kFrames, false, kSubsteps, kMargin);

@@ -22,7 +22,7 @@ World::World(const Eigen::Vector3d& gravity, std::optional<double> ground_height
   if (ground_height) {
     if (!std::isfinite(*ground_height)) throw std::invalid_argument("ground height is not finite");
     // A thin box, not a btStaticPlaneShape: Bullet's soft-rigid contacts sample a signed
-    // distance grid that only convex shapes have (README, "Free pieces and collisions").
+    // distance grid that only convex shapes have (docs/library.md, "Free pieces and collisions").
     ground_shape = std::make_unique<btBoxShape>(btVector3(50, btScalar(kGroundHalfThickness), 50));
     ground_motion = std::make_unique<btDefaultMotionState>(
         btTransform(btQuaternion::getIdentity(),
