@@ -161,7 +161,7 @@ void tear_step(benchmark::State& state, int faces, int mode) {
 }
 
 // A whole 100-sample stroke (the first sample finds the blade's hit: index query or scan);
-// smooth_lips (issue 18's lips, as tear-opening tears) against the default tear, its baseline.
+// smooth_lips (the smooth lips tear-opening tears with) against the default tear, its baseline.
 void tear100(benchmark::State& state, int faces, int mode, bool smooth_lips = false) {
   const Model& m = model(faces);
   Workbench bench{m, false, {}};

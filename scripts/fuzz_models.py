@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Mutation campaign against the model import path of `conform` (issue 16).
+"""Mutation campaign against the model import path of `conform`.
 
 Makes N mutants of each seed model (truncation, byte flips, zero runs, special numbers,
 duplicated runs, deletions), runs `conform info`, `cut` and `drill` on each with a time limit,

@@ -1,4 +1,4 @@
-// Exact bind transforms, weights and instances (issue 13) on the real models of Debian's
+// Exact bind transforms, weights and instances on the real models of Debian's
 // assimp-testmodels, as imported: CGA skinning against matrix skinning computed from the
 // file's raw (unprojected) matrices, within 1e-6 of the model's diagonal (float storage), at
 // the rest pose and at key times of every animation.

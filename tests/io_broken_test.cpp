@@ -67,7 +67,7 @@ INSTANTIATE_TEST_SUITE_P(
       return n;
     });
 
-// Weights off 1 are normalized by default (issue 13: engines normalize on import), with one
+// Weights off 1 are normalized by default (engines normalize on import), with one
 // warning that gives the range of the sums; strict_weights refuses them (above).
 TEST(IoBroken, WeightsOffOneAreNormalizedWithOneWarningByDefault) {
   for (const char* file : {"simple_skin_bad_weights.gltf", "simple_skin_bad_joint.gltf"}) {

@@ -1,4 +1,4 @@
-// How much a tear's border looks like a wound (issue 18 item 3), measured on the mesh alone:
+// How much a tear's border looks like a wound, measured on the mesh alone:
 // how far the border lies from the blade's swept surface, how evenly its points are spaced,
 // how many thin triangles converge on one vertex, and, after opening, how sharply each lip
 // turns from one segment to the next.

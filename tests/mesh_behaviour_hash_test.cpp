@@ -1,7 +1,7 @@
 // A fingerprint of the mesh layer's behaviour: 2,000 seeded random cuts (with and without caps),
 // tear strokes and drills (with and without tube walls; with a kept FaceIndex and without) on the
 // procedural arm, a sheet and a sphere, hashed, against a constant recorded on the code before the
-// restructuring of issue 14. A refactoring that changes any output changes the hash.
+// restructuring of the mesh edits. A refactoring that changes any output changes the hash.
 //
 // Hashed: every returned TopologyChange (topology integers exactly, coefficients rounded to
 // 1e-9), every result's counters and message, and the whole mesh after each group of operations
@@ -288,8 +288,8 @@ TEST(MeshBehaviourHash, TwoThousandRandomOperations) {
               tally.capped, tally.inside_out, tally.cut_unsnapped, tally.border_stops);
   char hex[32];
   std::snprintf(hex, sizeof hex, "0x%016llx", static_cast<unsigned long long>(h.value()));
-  // Recorded on the code before the restructuring of issue 14 (commit 98647a8):
-  // 0x0431338af34689ee, unchanged by the restructuring. The tear's walk bound (issue 12) then
+  // Recorded on the code before the mesh edits were restructured (commit 98647a8):
+  // 0x0431338af34689ee, unchanged by the restructuring. The tear's walk bound then
   // changed the message of 4 samples that already failed (their walks left the region the
   // blade swept by more than 8 edges); every mesh change is the same: 0xf46e68cfa1d01bdd.
   // The drill's pinch check (drill_pinch.hpp) then changed the 5 drills that had left a

@@ -220,7 +220,7 @@ int side(const std::vector<Eigen::Vector3d>& points, const Eigen::Vector3d& n, d
 
 }  // namespace
 
-// A posed edit (issue 13): the cut is made on the model posed at --time, so the posed pieces lie
+// A posed edit: the cut is made on the model posed at --time, so the posed pieces lie
 // on the two sides of the plane and add up to the posed model's area (written by `conform skin`
 // at the same time); the rest pieces add up to the model's area at rest, and at rest the plane
 // no longer separates them.

@@ -1,4 +1,4 @@
-// The tear's lips (issue 18 item 3): a straight, a curved and an oblique stroke on the procedural
+// The tear's lips: a straight, a curved and an oblique stroke on the procedural
 // arm, shaped like tear-opening's (40 samples over 12 cm, the blade through the +x wall), and a
 // stroke on a real model, measured by lip_quality.hpp.
 #include <gtest/gtest.h>
@@ -90,7 +90,7 @@ TEST(TearLips, OnTheArm) {
   // 0.028 / 0.230, 0.012 / 0.131 local edges; lip turning after opening 0.7 / 136, 10.0 / 166,
   // 3.7 / 164 degrees; longest over shortest path segment 1.01 / 6.75, 1.36 / 8.37,
   // 1.05 / 13.4; thin faces on one vertex 0 / 3, 2 / 5, 3 / 5 (straight, curved, oblique).
-  // Issue 18's bounds (0.1 edge, 30°) hold on all three; every face the tear adds or flips keeps
+  // The lips' bounds (0.1 edge, 30°) hold on all three; every face the tear adds or flips keeps
   // the sliver floor (5°).
   const SkinnedMesh in = make_arm(1).mesh;
   const char* names[] = {"straight", "curved", "oblique"};
@@ -110,7 +110,7 @@ TEST(TearLips, OnTheArm) {
     EXPECT_LT(q.fan, b.fan) << what;
     EXPECT_LE(q.track_distance, b.track_distance + 1e-9) << what;
     EXPECT_LT(q.turning_deg, 0.3 * b.turning_deg) << what;
-    EXPECT_LT(q.track_distance, 0.1) << what;  // issue 18's bounds
+    EXPECT_LT(q.track_distance, 0.1) << what;  // the lips' bounds
     EXPECT_LT(q.turning_deg, 30) << what;
     EXPECT_LT(q.spacing_ratio, 2) << what;  // one path point per sample, evenly spaced
     EXPECT_GE(floor.added, kTearMinAngle * 180 / std::numbers::pi - 1e-9) << what;
@@ -128,7 +128,7 @@ TEST(TearLips, OnARealModel) {
   // side (1.6 edges off the swept surface, with or without smooth_lips) to the far branch of the
   // blade plane's section, along which the path turns about (167° at that point, a real
   // reversal of the track, not a fold of the surface); with smooth_lips the tear then stops where
-  // the walk comes back beside its own lips (6 of 24 samples extend it, 7 before). Issue 18's
+  // the walk comes back beside its own lips (6 of 24 samples extend it, 7 before). The lips'
   // bounds hold on the four strokes the default tear follows (within an edge of the swept
   // surface).
   const auto path = std::filesystem::path(CONFORM_ASSIMP_MODELS) / "FBX/huesitos.fbx";

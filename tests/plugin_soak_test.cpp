@@ -1,4 +1,4 @@
-// A random-operation soak of a running simulation (issue 16): on the procedural arm and on two
+// A random-operation soak of a running simulation: on the procedural arm and on two
 // real characters of Debian's assimp-testmodels, a seeded random sequence of cuts (capped or
 // not, regional or not), tears (a few scalpel samples each), drills, releases of pieces,
 // animation changes and steps, then the teardown in a random one of the two supported orders

@@ -1,4 +1,4 @@
-// Progress on stderr (scenes/base/progress.hpp, issue 18 item 4), through the real `conform`
+// Progress on stderr (scenes/base/progress.hpp), through the real `conform`
 // command: a run longer than a second shows it, as plain lines (at most one per tenth, the last at
 // 100 %) when stderr is a file and as a bar redrawn in place on a terminal (util-linux's
 // `script` gives the run a pseudo-terminal); a run shorter than a second shows none.

@@ -15,13 +15,13 @@ struct Context {
   int exit_code = 0;
 };
 
-void register_info(CLI::App& app, Context& context);      // cmd_info.cpp   (issue 3 extends)
-void register_ik(CLI::App& app, Context& context);        // cmd_ik.cpp     (issue 4)
-void register_skin(CLI::App& app, Context& context);      // cmd_skin.cpp   (issue 3)
-void register_mesh_ops(CLI::App& app, Context& context);  // cmd_mesh_ops.cpp (issue 5)
-void register_run(CLI::App& app, Context& context);       // cmd_run.cpp    (issue 7)
-void register_scenes(CLI::App& app, Context& context);    // cmd_run.cpp    (issue 7)
-void register_sweep(CLI::App& app, Context& context);     // cmd_sweep.cpp  (issue 17)
+void register_info(CLI::App& app, Context& context);      // cmd_info.cpp
+void register_ik(CLI::App& app, Context& context);        // cmd_ik.cpp
+void register_skin(CLI::App& app, Context& context);      // cmd_skin.cpp
+void register_mesh_ops(CLI::App& app, Context& context);  // cmd_mesh_ops.cpp
+void register_run(CLI::App& app, Context& context);       // cmd_run.cpp
+void register_scenes(CLI::App& app, Context& context);    // cmd_run.cpp
+void register_sweep(CLI::App& app, Context& context);     // cmd_sweep.cpp
 
 /// --strict-weights: the one name of io::ImportOptions::strict_weights on every command that
 /// loads a model (scene files: model.strict_weights).

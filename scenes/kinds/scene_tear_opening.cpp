@@ -190,7 +190,7 @@ class TearOpening final : public Scene {
       body.set_pose(pose);
       body.begin_tear(lips());
     }
-    // Both runs tear with issue 18's smooth lips (tear.hpp).
+    // Both runs tear with the same smooth lips (tear.hpp).
     static mesh::TearOptions lips() {
       mesh::TearOptions o;
       o.smooth_lips = true;

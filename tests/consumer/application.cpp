@@ -1,5 +1,5 @@
 // A Bullet application written against an installed Conform (find_package), as the developer
-// of an existing Bullet program would write it (issue 15's "must show"):
+// of an existing Bullet program would write it (as the install test requires):
 //   - its own btSoftRigidDynamicsWorld, a ground box and two dynamic rigid boxes;
 //   - a real rigged model (argv[1], read with conform::io) playing its animation;
 //   - the procedural arm driven by the closed-form CGA IK toward a moving target;
