@@ -4,45 +4,9 @@
 // share of the rest area (a third of its faces' rest areas), and every element quantity is a
 // per-area property times the element's rest area, so the material does not depend on the mesh.
 //
-// Sources for the defaults (human skin in vivo, forearm and upper arm):
-//   - Young's modulus 0.42 MPa: Agache, Monneur, Leveque & De Rigal, "Mechanical properties and
-//     Young's modulus of human skin in vivo", Arch Dermatol Res 269:221-232 (1980), torsion
-//     tests, 0.42 MPa under 30 years, 0.85 MPa over 30.
-//   - Poisson's ratio 0.48 (nearly incompressible tissue) and thickness 1.5 mm (dermis and
-//     epidermis of the arm, 1-2 mm by ultrasound): Joodaki & Panzer, "Skin mechanical properties
-//     and modeling: a review", Proc IMechE H 232(4):323-343 (2018), its tables 1 and 3.
-//   - Pre-strain of 10-20 % in vivo (Joodaki & Panzer 2018, section "Pre-stress"); the default
-//     pre-stress is an equibiaxial pre-strain of 10 %: sigma = E eps / (1 - nu) = 80.8 kPa.
-//   - Density 1.1e3 kg/m^3 x 1.5 mm = 1.65 kg/m^2.
-//   - Attachment: the hypodermis as a shear layer, k = G / h with G about 2 kPa (adipose
-//     tissue at low rates, Geerligs et al., Biorheology 45:677-688, 2008) and h about 5 mm:
-//     4e5 Pa/m. Its decay length sqrt(E t / k) is then about 4 cm.
-//   - Normal support: the body beneath resists indentation far more than shear; 100 x the
-//     tangential stiffness keeps the skin from sinking under its own curvature load sigma t / R.
-//   - Neo-Hookean law: skin is nearly incompressible (nu 0.48 above), and an incompressible
-//     solid's shear modulus is linear elasticity's mu = E / (2 (1 + nu)) at nu = 1/2, E / 3;
-//     with it the law's small-strain limit is linear elasticity with nu = 1/2, the same E.
-//     Skin's stress-strain curve is J-shaped (stiffens with stretch; Joodaki & Panzer 2018);
-//     neo-Hookean is the simplest hyperelastic law that stays valid at 10-20 % pre-strain
-//     (it stiffens mildly, far less than skin past the toe region).
-//   - Fibre-reinforced law (collagen along the skin-tension lines): a Holzapfel-Gasser-Ogden fibre
-//     term, one family without dispersion. Its two parameters are set from two figures of
-//     Ni Annaidh, Bruyere, Destrade, Gilchrist & Ottenio, "Characterising the anisotropic
-//     mechanical properties of excised human skin", J Mech Behav Biomed Mater 5:139-148 (2012),
-//     scaled to the in-vivo modulus above: k1 = 0.19 E makes the small-strain modulus along the
-//     fibres 1.76 x the modulus across them (E + 4 k1 against E), their ratio of the mean moduli
-//     parallel and perpendicular to Langer's lines (112.5 and 63.8 MPa); k2 = 1.285 makes the
-//     tangent of the uniaxial nominal stress along the fibres at their mean failure strain, 54 %,
-//     70.6 x its value at zero strain, their ratio of the mean linear-region modulus to the mean
-//     initial slope (83.3 and 1.18 MPa): skin's J-shaped curve (membrane_law_test checks both).
-//   - Toughness (critical energy release rate) G_c: published values for skin span about
-//     1-30 kJ/m^2 depending on the test (trouser tear, notched tension, scissors cutting) and
-//     on species and site; the default, 2 kJ/m^2, is an order of magnitude within that span,
-//     not one measurement. At it, Griffith's stress sqrt(E G_c / (pi a)) of a 1 cm slit in the
-//     default skin is about 0.23 MPa, 0.55 E: skin is notch-insensitive at these sizes, and
-//     linear fracture mechanics (membrane-griffith) needs a far lower G_c to stay at small strain.
-//   - Damping: not measured in these units; the default is about critical for the attachment,
-//     2 sqrt(k rho_A) = 1.6e3 Pa s/m, so that secondary motion settles in tens of milliseconds.
+// The defaults are human skin in vivo (forearm and upper arm). Their sources, and the
+// derivations of the derived ones (pre-stress, attachment, damping, the fibres' k1 and k2,
+// the toughness), are in docs/notes/membrane.md.
 #pragma once
 
 #include <Eigen/Core>
@@ -68,10 +32,10 @@ struct SkinMaterial {
   /// Young's modulus E, Pa, > 0 (skin in vivo: 0.1-1 MPa; default 0.42 MPa).
   double youngs_modulus = 0.42e6;
   /// The fibres' stiffness k1 of Law::fibre_reinforced, Pa, finite and >= 0 (default 79.8 kPa,
-  /// 0.19 x the default E; see the sources above). Unused by the other laws.
+  /// 0.19 x the default E; docs/notes/membrane.md). Unused by the other laws.
   double fibre_stiffness = 79.8e3;
   /// The fibres' stiffening exponent k2 of Law::fibre_reinforced, dimensionless, in (0, 100]
-  /// (default 1.285; see the sources above). Unused by the other laws.
+  /// (default 1.285; docs/notes/membrane.md). Unused by the other laws.
   double fibre_nonlinearity = 1.285;
   /// Poisson's ratio nu of the membrane (plane stress), in [0, 0.5) (default 0.48); the stvk
   /// law's only (the neo-Hookean laws are incompressible, nu = 1/2).
@@ -116,8 +80,8 @@ struct SkinMaterial {
   double attachment_damping = 1.6e3;
   /// Toughness G_c, J/m^2: the energy per unit area of new crack surface through the thickness
   /// (a crack of length a in a membrane of thickness t releases G t da), at which a tear grows
-  /// (membrane/crack_growth.hpp). In (0, 1e6] (human skin about 1e3-3e4; default 2e3, see the
-  /// sources above). Unused unless crack growth is asked for.
+  /// (membrane/crack_growth.hpp). In (0, 1e6] (human skin about 1e3-3e4; default 2e3,
+  /// docs/notes/membrane.md). Unused unless crack growth is asked for.
   double toughness = 2.0e3;
   /// Wrinkling: the membrane carries no compression (tension-field theory, Pipkin 1986): where
   /// a principal stress would go negative the skin buckles out of its plane instead, and the

@@ -11,8 +11,8 @@ enum class Preconditioner {
   /// M = D (the 3 x 3 diagonal blocks).
   block_jacobi,
   /// Symmetric block Gauss-Seidel, M = (D + L) D^-1 (D + L)^T, applied by Eisenstat's trick
-  /// (one triangular sweep each way per iteration, about the cost of one Jacobi iteration):
-  /// about half the iterations of block_jacobi on the skin's systems (plugin_bench).
+  /// (one triangular sweep each way per iteration, about the cost of one Jacobi iteration).
+  /// Fewer iterations than block_jacobi on the skin's systems (docs/notes/membrane.md).
   symmetric_gauss_seidel,
 };
 
@@ -20,9 +20,8 @@ struct SolverSettings {
   /// Stop when the largest |nodal force| / (node area x S) over the free nodes is below this,
   /// where S is the material's stress scale (SkinMaterial::stress_scale: the larger pre-stress,
   /// or E without one). Dimensionless, so the same setting means the same accuracy at every
-  /// stress level. The default, 1.2e-3 (97 Pa for skin's 80.8 kPa pre-stress), is converged for
-  /// the tear-opening wound: 4x tighter changes its largest opening by 0.007 % (res 1) and
-  /// 0.007 % (res 2), 4x looser by 0.27 % / 0.07 % (measured at 100 Pa).
+  /// stress level. Default 1.2e-3 (97 Pa for skin's 80.8 kPa pre-stress), converged for the
+  /// tear-opening wound (docs/notes/membrane.md).
   double relative_tolerance = 1.2e-3;
   int max_newton_iterations = 40;
   int max_cg_iterations = 400;
@@ -39,7 +38,7 @@ struct SolverSettings {
   double local_reach = 2;
   /// Solve each symmetric_gauss_seidel system on a packed copy of its active rows (contiguous
   /// memory, the same step bit for bit). false: in place over the whole mesh's arrays (the
-  /// solver before; the benchmarks' baseline).
+  /// benchmarks' baseline).
   bool packed_systems = true;
   /// OpenMP threads for the element and node loops of large meshes (1: serial). The results do
   /// not depend on it (every sum is gathered per vertex in a fixed order).
