@@ -18,9 +18,8 @@
 // behind the tip are
 //   delta_n = 8 K_I / E sqrt(r / (2 pi)),   delta_t = 8 K_II / E sqrt(r / (2 pi)),
 // so K(r) = E / 8 sqrt(2 pi / r) delta, fitted by a line over the lip pairs in the domain's ring
-// r_in <= r <= R and taken at r = 0. The constant-strain elements nearer the tip resolve the
-// sqrt(r) field worst: with their pairs in the fit, an inclined slit's K_II came 4-5 % low and
-// the correlation's own K_I, K_II 7 % and 12 % low; without them, within 1.3 % and 2.5 %. Its ratio
+// r_in <= r <= R and taken at r = 0 (the constant-strain elements nearer the tip resolve the
+// sqrt(r) field worst, so their pairs are left out; docs/notes/membrane.md). The fit's ratio
 // gives the phase psi = atan2(K_II, K_I), and the energy gives the size: K_I = sqrt(E G) cos psi,
 // K_II = sqrt(E G) sin psi (G = (K_I^2 + K_II^2) / E in plane stress). E is the law's small-strain
 // Young's modulus (isotropic laws: the fibre-reinforced law's mix is not this closed form).

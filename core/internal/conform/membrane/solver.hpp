@@ -1,7 +1,7 @@
 // One implicit (backward Euler) step, or a static solve, of a membrane attached to its skinned
 // targets, solved to a residual: Newton's method on the step's incremental potential, each
-// Newton system solved by conjugate gradients with a 3 x 3 block-Jacobi preconditioner, and a
-// backtracking line search on the potential.
+// Newton system solved by conjugate gradients (preconditioned as SolverSettings::preconditioner
+// says), and a backtracking line search on the potential.
 //
 // The potential minimised over the free nodes' positions x (fixed nodes stay where they are):
 //   Phi(x) = U(x)                                           membrane (model.hpp)
@@ -15,18 +15,10 @@
 // pre-stress, or the modulus without one): it means the same on every mesh and at every
 // stress level.
 //
-// Backward Euler's numerical damping. An oscillator of angular frequency omega (the skin on its
-// attachment: omega^2 = k / rho_A) is multiplied each step by z = 1 / (1 + i omega dt): the
-// amplitude by (1 + (omega dt)^2)^(-1/2) and the phase by atan(omega dt). The period is then
-// omega dt / atan(omega dt) times too long and the amplitude falls by |z|^(2 pi / atan(omega dt))
-// per period, a numerical damping ratio of about omega dt / 2 at small omega dt (measured in
-// benchmarks/membrane_integrator_bench to 4 digits): omega dt = 0.1 gives +0.33 % on the period
-// and 27 % amplitude lost per period, 0.5 gives +7.8 % and 78 %. membrane-patch resolves its
-// oscillation (omega dt = 2 pi / 1000, a numerical damping ratio of 0.003 against its physical
-// 0.098: the 3 % excess it measures). tear-opening's skin (omega = 492 rad/s at dt = 1/60 s,
-// omega dt = 8.2) is numerically overdamped: each step keeps 12 % of an oscillation's
-// amplitude, so its skin follows the limb quasi-statically, as its attachment's near-critical
-// physical damping (ratio 0.98) would make it anyway.
+// Backward Euler's numerical damping: an oscillator of angular frequency omega (the skin on its
+// attachment: omega^2 = k / rho_A) is multiplied each step by z = 1 / (1 + i omega dt), so its
+// amplitude by (1 + (omega dt)^2)^(-1/2) and its phase by atan(omega dt): a numerical damping
+// ratio of about omega dt / 2 at small omega dt. Figures per scene: docs/notes/membrane.md.
 #pragma once
 
 #include <Eigen/Core>

@@ -31,7 +31,7 @@
 //   K_ab = A t [ (beta_a^T S+ beta_b) I + k h_a h_b^T + k/2 h_b h_a^T
 //                + k/2 (beta_a^T Ci beta_b) F Ci F^T ];
 // where wrinkled, the StVK blocks' v, u with p, m -> q, r (not unit) and the coefficients c1,
-// 2 c2 in place of (k - lambda^2 / k), 4 mu r. The StVK code paths are unchanged.
+// 2 c2 in place of (k - lambda^2 / k), 4 mu r.
 //
 // The fibre-reinforced law adds its fibre term (detail/fibre.hpp) to the neo-Hookean element in
 // every regime: S_f to S (so to P and S+), psi_f to psi, and to the material blocks, from
