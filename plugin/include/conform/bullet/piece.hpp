@@ -72,19 +72,16 @@ struct ReleaseOptions {
   double link_stiffness = 0.9;
   /// Keeps the volume the piece has at release: a bulk modulus K in Pa (>= 0; 0 = off), the
   /// pressure K (V0 − V) / V0 pushing on the closed surface. The plugin integrates it
-  /// implicitly, interleaved with the links' lengths, so every K is stable at any step (Bullet's
-  /// own explicit kVC blew a 5 cm piece up from 300 Pa on at 1/60 s). Needs a closed piece
-  /// (e.g. a capped cut). Measured on a capped forearm dropped 16 cm on a box: from 1000 Pa on,
-  /// 93-97 % of the volume is kept at rest with 4 substeps of 1/240 s; with one step of 1/60 s
-  /// the impact (1.8 m/s, 3 cm in one step) crumples it to about 71 %. Below about 100 Pa
-  /// (9 × the skin's weight per area, 1.1 kg/m² × g) it sags under its own weight.
+  /// implicitly, interleaved with the links' lengths, so every K is stable at any step (unlike
+  /// Bullet's own explicit kVC). Needs a closed piece (e.g. a capped cut). Below about 9 × the
+  /// skin's weight per area (1.1 kg/m² × g, about 100 Pa) the piece sags under its own weight.
+  /// Measured figures: docs/notes/plugin.md.
   double volume_modulus = 0.0;
   /// An inner pressure in Pa at the release volume (>= 0; 0 = off), following Boyle's law
   /// (p V = p0 V0), integrated implicitly as the modulus is. Needs a closed piece. Unlike the
   /// modulus it pushes at V0 too, and the links (solved by position) must carry its tension
-  /// p R / 2: 100 Pa holds the 5 cm forearm piece up (104 % of its volume), 1000 Pa at 1/240 s
-  /// pushed its bottom through the box it landed on. Keep it within about 10 × the skin's
-  /// weight per area, or keep the volume with volume_modulus.
+  /// p R / 2. Keep it within about 10 × the skin's weight per area, or keep the volume with
+  /// volume_modulus (docs/notes/plugin.md).
   double pressure = 0.0;
 };
 

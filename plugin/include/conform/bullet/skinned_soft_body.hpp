@@ -4,23 +4,25 @@
 // Mesh ↔ Bullet: nodes = vertices, links = edges of faces (the body's material 0), faces =
 // triangles, and optional bending links (material 1) joining the two vertices opposite each
 // edge shared by two faces. Every connected piece of the mesh is its own btSoftBody (Bullet's
-// face tree never returns on a body whose faces are not edge-connected). A vertex left without
-// faces (the inside of a drilled hole) is detached: it leaves Bullet (no node, link, collision
-// or solver work); its mass stays in the books (total_mass(), momentum()) as the removed
-// material's, with its state at the edit (so that edits conserve both exactly), and from the
-// next substep on it rides its skinned target.
+// face tree never returns on a body whose faces are not edge-connected).
 //
-// Vertices are never reclaimed (a documented bound instead of compaction): the vertex arrays
-// grow by exactly the new vertices of each change, vertex indices never change after an edit
-// (face indices do, see topology_version()), and the only vertices left unused are the detached
-// insides of drilled holes, each costing its per-vertex arrays (a few hundred bytes) and its
-// skinning every substep, no Bullet work (tests: DetachedVerticesAreBoundedByTheHoles).
+// Promises:
+//   - edits conserve mass and momentum exactly. A vertex left without faces (the inside of a
+//     drilled hole) is detached: it leaves Bullet (no node, link, collision or solver work);
+//     its mass stays in the books (total_mass(), momentum()) as the removed material's, with
+//     its state at the edit, and from the next substep on it rides its skinned target;
+//   - vertex indices never change after an edit (face indices do, see topology_version()).
+//     Vertices are never reclaimed (a documented bound instead of compaction): the arrays grow
+//     by exactly the new vertices of each change, and the only unused ones are the detached
+//     insides of drilled holes, each costing its per-vertex arrays and its skinning every
+//     substep, no Bullet work;
+//   - an edit costs time proportional to the change, and never triggers Bullet's whole-body
+//     reset (m_bUpdateRtCst).
 //
-// Edits cost time proportional to the change: nodes, links and faces are removed by
-// swap-with-last with local re-pointing; link constants, rest lengths and face areas of what
-// changed are written here, so Bullet's whole-body reset (m_bUpdateRtCst) is never triggered;
-// a split is found by searches from the changed vertices that stop once all but one of them
-// are exhausted, and only the exhausted (smaller) side moves into a new btSoftBody.
+// How edits are mirrored: nodes, links and faces are removed by swap-with-last with local
+// re-pointing; link constants, rest lengths and face areas of what changed are written here; a
+// split is found by searches from the changed vertices that stop once all but one of them are
+// exhausted, and only the exhausted (smaller) side moves into a new btSoftBody.
 //
 // Each substep (in the plugin's action, after Bullet's motion prediction and before its
 // constraint solve) the pose source gives a skeleton pose, CGA skinning gives every vertex its
@@ -34,6 +36,8 @@
 //   bullet_links: free nodes are pulled toward their target by an implicit spring–damper per
 //     node, and every link's rest length is re-applied from our own copy (Bullet resets rest
 //     lengths to the current lengths after any edit, which would wipe pretension).
+//
+// Measurements behind these choices: docs/notes/plugin.md.
 #pragma once
 
 #include "conform/bullet/precision.hpp"  // the package's Bullet precision, checked
@@ -70,7 +74,7 @@ namespace conform::bullet {
 
 /// How a skinned soft body's skin resists deformation.
 enum class MaterialModel {
-  /// The skin membrane (core/membrane): pre-stressed St Venant-Kirchhoff triangles in SI units
+  /// The skin membrane (core/membrane): pre-stressed triangles (SkinMaterial::law) in SI units
   /// attached to the skinned targets by the subcutaneous layer, solved each substep to a
   /// residual (Material::skin, Material::solver). Mesh- and solver-independent; the default.
   membrane,
@@ -214,7 +218,7 @@ class SkinnedSoftBody {
   void snap_to_pose();
   /// OpenMP threads of the skinning loop; 0 = the library's choice. Default 1: a fork/join
   /// every substep costs more than it saves on a few thousand vertices, and idle OpenMP
-  /// workers spinning on the second core slowed each Bullet step by 3-7× in our measurements.
+  /// workers slow Bullet's step (docs/notes/plugin.md).
   void set_skin_threads(int threads);
   /// Makes these vertices kinematic regardless of their weights (and the rest free unless
   /// above the weight threshold).
