@@ -9,25 +9,20 @@
 //   without bones becomes one rigid bone on its node. A bone without a node of its name gets a
 //   root joint of its own at its bind pose (O⁻¹), with a warning. A mesh placed by several
 //   nodes is imported once per node (MeshInfo::source names the file's mesh).
-// - Exact bind transforms: matrix skinning is x' = Σ w G_b O_b x (G_b the bone node's global
-//   matrix, O_b its offset). A mesh's bind transform K is its node's global transform, or,
-//   when the file's offsets ignore that node (X/test_cube_*.x), the one its first bone's
-//   offset implies (G_b O_b); with it every bone's rest skinning matrix G_b O_b K⁻¹ is a
-//   proper similarity. K = Q N, Q the nearest proper similarity, which the versors carry; N,
-//   the non-uniform stretch or mirror, is baked into the rest positions, x_rest = N x
-//   (normals by N⁻ᵀ, faces rewound when N mirrors; nothing is baked when K is a similarity).
-//   A mirroring node makes its subtree odd: its joints store F^parent L F^self with
-//   F = diag(1, 1, −1) (animation keys alike), which is proper, and the mirrors cancel in
-//   G_b O_b. A bone below an approximated node gets B_b = G̃_b⁻¹ · (G_b O_b N⁻¹), G̃_b its
-//   joint's global versor at rest, so the rest pose stays exact. What cannot be exact is a
-//   non-uniform scale that an animation really moves (animated, or above an animated bone)
-//   or a key that changes a node's parity: the nearest similarity is used, and the importer
-//   measures the result against matrix skinning of the file at the rest pose and every key
-//   time and warns with the largest deviation relative to the model's diagonal.
+// - Exact bind transforms: at the rest pose the model reproduces the file's matrix skinning
+//   x' = Σ w G_b O_b x (G_b the bone node's global matrix, O_b its offset). Each mesh's bind
+//   transform K = Q N: Q, the nearest proper similarity, is carried by the versors; N, the
+//   non-uniform stretch or mirror, is baked into the rest positions, x_rest = N x (normals by
+//   N⁻ᵀ, faces rewound when N mirrors; nothing is baked when K is a similarity). Mirroring
+//   nodes and bones below approximated nodes stay exact too. Not exact: a non-uniform scale
+//   that an animation really moves (animated, or above an animated bone), or a key that
+//   changes a node's parity. There the nearest similarity is used, and the importer warns with
+//   the largest deviation from the file's matrix skinning (at the rest pose and every key
+//   time) relative to the model's diagonal. Derivation: docs/notes/import_skinning_ik.md.
 // - Influences: all kept (SkinnedModel::influences). Each vertex's weights are normalized to
-//   sum 1; sums off by more than 1e-4 (exports that truncate influences, Blender's 0.94–1.38)
-//   give one summary warning, or with ImportOptions::strict_weights an error. A vertex whose
-//   bones give it no weight is an error.
+//   sum 1; sums off by more than 1e-4 (exports that truncate influences) give one summary
+//   warning, or with ImportOptions::strict_weights an error. A vertex whose bones give it no
+//   weight is an error.
 // - Animations: position, rotation and scaling keys per node channel, times in ticks;
 //   ticks per second 25 when the file says 0.
 // - Welding (ImportOptions::weld, on by default): each mesh's vertices at one position become
@@ -64,8 +59,7 @@ struct ImportOptions {
   /// model.strict_weights).
   bool strict_weights = false;
   /// Import in a forked child process (POSIX) with the caps of `isolation`, so that a file on
-  /// which assimp crashes, hangs or allocates without bound (assimp 5.2 segfaults, aborts or
-  /// corrupts its heap on out-of-range bone or vertex indices in .x, .dae and .md5mesh files)
+  /// which assimp crashes, hangs or allocates without bound (docs/notes/import_skinning_ik.md)
   /// gives an ImportError saying so instead of killing or corrupting the caller: the child does
   /// the whole import and sends the model back as bytes; assimp never runs in the caller. The
   /// child dies with the calling thread. Off by default for library users: forking a

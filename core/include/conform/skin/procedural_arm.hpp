@@ -8,7 +8,7 @@
 // The surface is `rings` rings of `segments` vertices each, plus one pole vertex at each end:
 //   #V = rings · segments + 2,   #F = 2 · rings · segments   (closed genus 0: #F = 2 #V − 4).
 // Resolution N scales both counts linearly (segments = 32 N, rings = 80 N), so
-//   N = 1  →  2,562 vertices,   5,120 faces   (the second paper's arm: 3,069 / 5,037)
+//   N = 1  →  2,562 vertices,   5,120 faces   (about the second paper's arm)
 //   N = 14 →  ~502k vertices,   ~1.0M faces
 //   N = 20 →  ~1.02M vertices,  ~2.05M faces.
 // Vertex order: pole at the shoulder end (index 0), the rings from the shoulder to the hand
@@ -50,7 +50,7 @@ struct Arm {
 inline constexpr const char* kArmJointNames[3] = {"shoulder", "elbow", "wrist"};
 
 /// The largest resolution make_arm builds: N = 32 is 2,621,442 vertices. The surface grows as
-/// N², and arm:50 already peaked at 4.2 GB in `conform`; arm:200 would need tens of GB.
+/// N², and so does memory (docs/notes/import_skinning_ik.md).
 inline constexpr int kMaxArmResolution = 32;
 /// The most vertices make_arm builds (those of N = kMaxArmResolution), explicit counts too.
 inline constexpr long long kMaxArmVertices = 80LL * kMaxArmResolution * 32 * kMaxArmResolution + 2;
