@@ -19,25 +19,18 @@
 //   - an edit costs time proportional to the change, and never triggers Bullet's whole-body
 //     reset (m_bUpdateRtCst).
 //
-// How edits are mirrored: nodes, links and faces are removed by swap-with-last with local
-// re-pointing; link constants, rest lengths and face areas of what changed are written here; a
-// split is found by searches from the changed vertices that stop once all but one of them are
-// exhausted, and only the exhausted (smaller) side moves into a new btSoftBody.
-//
-// Each substep (in the plugin's action, after Bullet's motion prediction and before its
-// constraint solve) the pose source gives a skeleton pose, CGA skinning gives every vertex its
-// target, and
-//   kinematic nodes (pinned; with bullet_links also those whose largest bone weight is ≥
-//     Material::kinematic_weight) are placed on their target (Bullet inverse mass 0; velocity
-//     (target − previous) / dt);
-//   membrane (the default): the free nodes take one backward-Euler step of the skin membrane
-//     attached to the targets, solved to Material::solver.relative_tolerance (last_solve());
-//     Bullet's links are inert (their constant c0 is 0) and its contacts act on the result;
-//   bullet_links: free nodes are pulled toward their target by an implicit spring–damper per
-//     node, and every link's rest length is re-applied from our own copy (Bullet resets rest
-//     lengths to the current lengths after any edit, which would wipe pretension).
-//
-// Measurements behind these choices: docs/notes/plugin.md.
+// How: an edit removes nodes, links and faces by swap-with-last with local re-pointing, and
+// writes the link constants, rest lengths and face areas of what changed itself; a split is
+// found by searches from the changed vertices that stop once all but one of them are exhausted,
+// and only the exhausted (smaller) side moves into a new btSoftBody. Each substep (in the
+// plugin's action, after Bullet's motion prediction, before its constraint solve) skins the
+// pose source's pose to one target per vertex and places the kinematic nodes on theirs (Bullet
+// inverse mass 0, velocity (target − previous) / dt). With the membrane (the default) the free
+// nodes then take one backward-Euler step of the skin membrane (last_solve()), Bullet's links
+// are inert (c0 = 0) and its contacts act on the result; with bullet_links an implicit
+// spring–damper per node pulls them toward their targets, and every link's rest length is
+// re-applied from our own copy (Bullet resets rest lengths to the current lengths after any
+// edit, which would wipe pretension). Figures: docs/notes/plugin.md.
 #pragma once
 
 #include "conform/bullet/precision.hpp"  // the package's Bullet precision, checked
