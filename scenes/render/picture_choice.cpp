@@ -81,14 +81,12 @@ bool PictureCandidates::worth_offering(int step, const std::vector<double>& woun
   if (frames_.empty()) return true;
   const auto& last = frames_.back();
   if (double(step - last.front().step) * double(budget_) >= double(run_steps)) return true;
+  const std::vector<double> kept = largest_wounds();
   for (std::size_t p = 0; p < wounds.size() && p < last.size(); ++p) {
     const double w = wounds[p], before = last[p].wound;
     if (std::isfinite(w) != std::isfinite(before)) return true;
     if (!std::isfinite(w)) continue;
-    double largest = std::abs(w);
-    for (const auto& f : frames_)
-      if (p < f.size() && std::isfinite(f[p].wound))
-        largest = std::max(largest, std::abs(f[p].wound));
+    const double largest = std::max(std::abs(w), p < kept.size() ? kept[p] : 0.0);
     if (std::abs(w - before) * double(budget_) > largest) return true;
   }
   return false;
@@ -125,13 +123,19 @@ double PictureCandidates::importance(std::size_t i, const std::vector<double>& s
   return std::max(change, gap);
 }
 
-void PictureCandidates::thin() {
+// Each panel's largest |wound| over the frames kept (0 where it has none).
+std::vector<double> PictureCandidates::largest_wounds() const {
   std::vector<double> scale;
   for (const auto& f : frames_)
     for (std::size_t p = 0; p < f.size(); ++p) {
       if (scale.size() <= p) scale.resize(p + 1, 0.0);
       if (std::isfinite(f[p].wound)) scale[p] = std::max(scale[p], std::abs(f[p].wound));
     }
+  return scale;
+}
+
+void PictureCandidates::thin() {
+  const std::vector<double> scale = largest_wounds();
   std::size_t least = 1;
   double least_importance = std::numeric_limits<double>::infinity();
   for (std::size_t i = 1; i + 1 < frames_.size(); ++i) {

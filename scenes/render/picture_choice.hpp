@@ -50,6 +50,7 @@ class PictureCandidates {
   PictureChoice choose(std::size_t pictures) const;
 
  private:
+  std::vector<double> largest_wounds() const;
   double importance(std::size_t i, const std::vector<double>& scale) const;
   void thin();
 
