@@ -97,6 +97,7 @@ void validate(const Material& material) {
   if (material.model == MaterialModel::membrane) {
     material.skin.validate();  // throws naming the field and its value
     material.solver.validate();
+    material.growth.validate();
   }
 }
 
@@ -224,6 +225,7 @@ mesh::DrillResult SkinnedSoftBody::Impl::drill(const mesh::DrillTool& tool,
 void SkinnedSoftBody::Impl::begin_tear(const mesh::TearOptions& options) {
   check_editable("begin_tear");
   tear_ = std::make_unique<mesh::Tear>(mesh_, adjacency_, face_index_, options);
+  growth_ = {};
   blade_.reset();
 }
 
@@ -389,6 +391,13 @@ mesh::TearStep SkinnedSoftBody::tear_advance(const mesh::ScalpelSample& sample) 
 }
 const mesh::Tear* SkinnedSoftBody::tear() const {
   return impl_->tear();
+}
+TearGrowthReport SkinnedSoftBody::grow_tear() {
+  impl_->check_editable("grow_tear");
+  return impl_->growth_.grow(*this);
+}
+double SkinnedSoftBody::tear_grown_length() const {
+  return impl_->growth_.grown();
 }
 void SkinnedSoftBody::apply(const mesh::TopologyChange& change) {
   impl_->apply(change);

@@ -28,6 +28,7 @@
 #include "conform/mesh/split_search.hpp"
 #include "membrane_drive.hpp"
 #include "skin_drive.hpp"
+#include "tear_growth.hpp"
 
 struct btDbvtNode;
 
@@ -227,6 +228,7 @@ struct SkinnedSoftBody::Impl {
   skin::Skeleton skeleton_;
   Material material_;
   std::unique_ptr<mesh::Tear> tear_;
+  TearGrowth growth_;  // the tear's own growth (Material::growth)
   SkinDrive drive_;  // after skeleton_, which it reads
   MembraneDrive membrane_;
   std::vector<void*> vertex_node_;  // per vertex: its btSoftBody::Node (null when detached)

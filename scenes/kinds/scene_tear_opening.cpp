@@ -11,6 +11,8 @@
 // opens as an ellipse). pose.flex_deg flexes the elbow after the stroke (the physical wound
 // follows the pose, the geometric one does not); tear.direction = "across" turns the incision
 // around the limb, across skin-tension lines given by material.prestress / prestress_axis.
+// tear.growth lets the physical tear grow by itself once the stroke is done, where the energy
+// release rate at a tip reaches material.toughness (Material::growth, tear_growth.hpp).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -51,7 +53,8 @@ constexpr const char* kTearOpeningJson = R"json({
   "tear": {
     "at": 0.5, "duration": 0.5, "samples": 40,
     "from": [0, 0.0023, 0.3712], "to": [0, 0.0023, 0.4912],
-    "blade_a": [0.09, 0, 0], "blade_b": [0.005, 0, 0], "direction": "along"
+    "blade_a": [0.09, 0, 0], "blade_b": [0.005, 0, 0], "direction": "along",
+    "growth": false, "growth_radius": 0.015
   },
   "geometric": { "amount": 0.01 },
   "profiles": { "snapshots": 6, "points": 41 },
@@ -103,6 +106,10 @@ class TearOpening final : public Scene {
       stroke_.from = centre - half * Vec3::UnitY();
       stroke_.to = centre + half * Vec3::UnitY();
     }
+    material_.growth.enabled = tear.boolean("growth", false);
+    material_.growth.domain_radius = tear.number("growth_radius", 0.015, 1e-4, 1);
+    if (material_.growth.enabled && material_.model != bullet::MaterialModel::membrane)
+      tear.fail("growth", true, "needs material.model = membrane (Griffith on its energy)");
     tear.finish();
     compare_ = read_comparison_keys(root);  // geometric.amount in metres
     common_ = read_common(root, name, 3.0, steps_override);
@@ -121,7 +128,8 @@ class TearOpening final : public Scene {
     out.open_metrics({"t", "physics_tear_points", "geometric_tear_points", "physics_max_opening",
                       "geometric_max_opening", "physics_area", "geometric_area",
                       "physics_profile_r2", "geometric_profile_r2", "pieces",
-                      "physics_newton_iterations", "physics_cg_iterations", "physics_residual"});
+                      "physics_newton_iterations", "physics_cg_iterations", "physics_residual",
+                      "physics_energy_release_rate", "physics_grown_length"});
     r.profiles.open_history(out);
     const Lips no_lips_yet;
     out.body_frame("physics", 0, r.body, &no_lips_yet);
@@ -131,6 +139,7 @@ class TearOpening final : public Scene {
       const double t = step * c.dt;
       note_solve(r, t);
       r.tear_ms += milliseconds([&] { advance_stroke(r, t); });  // edits only between steps
+      if (r.next == stroke_.samples) grow(r, t);
       r.measure_ms += milliseconds([&] { measure(r, step, t, out); });
       const bool frame = out.frame_step(step);
       if (frame || out.offers_pictures()) {
@@ -177,6 +186,9 @@ class TearOpening final : public Scene {
     Profile phys, geom;
     double max_phys = 0, max_geom = 0, tear_ms = 0, measure_ms = 0, physics_ms = 0;
     int tear_steps = 0;
+    // The tear's own growth: G at its tips at the last judgement and over the run, J/m^2.
+    double g_now = 0, g_max = 0, growth_ms = 0, growth_onset = -1;
+    int growth_steps = 0;
     double worst_residual = 0, before_flex = -1;  // the membrane's solves; the opening then
     int unconverged = 0;
 
@@ -264,6 +276,20 @@ class TearOpening final : public Scene {
     if (r.next == stroke_.samples && !r.geo.opened()) r.geo.open(compare_.amount);
   }
 
+  // Griffith's growth of the physical tear (nothing unless tear.growth): its tips' G, and when
+  // it first grew.
+  void grow(TearRun& r, double t) const {
+    if (!material_.growth.enabled) return;
+    bullet::TearGrowthReport report;
+    r.growth_ms += milliseconds([&] { report = r.body.grow_tear(); });
+    ++r.growth_steps;
+    r.g_now = 0;
+    for (const bullet::TipGrowth& tip : report.tips)
+      r.g_now = std::max(r.g_now, tip.energy_release_rate);
+    r.g_max = std::max(r.g_max, r.g_now);
+    if (report.grown > 0 && r.growth_onset < 0) r.growth_onset = t;
+  }
+
   // Both profiles now; a metrics row, the profile history and the snapshots when due.
   void measure(TearRun& r, int step, double t, RunOutput& out) const {
     const mesh::Tear* pt = r.body.tear();
@@ -285,7 +311,9 @@ class TearOpening final : public Scene {
                             double(r.body.piece_count()),
                             double(solve.newton_iterations),
                             double(solve.cg_iterations),
-                            solve.residual};
+                            solve.residual,
+                            r.g_now,
+                            r.body.tear_grown_length()};
       out.metrics().row(row);
       if (r.next > 0) r.profiles.history_row(t, r.phys, r.geom);
     }
@@ -332,6 +360,11 @@ class TearOpening final : public Scene {
     metrics["physics"]["newton_iterations"] = solve.newton_iterations;
     metrics["physics"]["cg_iterations"] = solve.cg_iterations;
     metrics["physics"]["max_opening_before_flex"] = r.before_flex;
+    metrics["physics"]["growth"] = material_.growth.enabled;
+    metrics["physics"]["grown_length"] = r.body.tear_grown_length();
+    metrics["physics"]["max_energy_release_rate"] = r.g_max;
+    metrics["physics"]["toughness"] = material_.skin.toughness;
+    metrics["physics"]["growth_onset_time"] = r.growth_onset;
     metrics["physics"]["material"] =
         material_.model == bullet::MaterialModel::membrane ? "membrane" : "bullet_links";
     metrics["tear_direction"] = across_ ? "across" : "along";
@@ -347,6 +380,7 @@ class TearOpening final : public Scene {
             {"tear_ms_total", r.tear_ms},
             {"tear_ms_per_sample", r.tear_steps ? r.tear_ms / r.tear_steps : 0.0},
             {"measure_ms_per_step", r.measure_ms / c.steps},
+            {"growth_ms_per_judgement", r.growth_steps ? r.growth_ms / r.growth_steps : 0.0},
             {"build_ms", r.build_ms},
             {"vertices", r.arm.mesh.vertex_count()},
             {"faces", r.arm.mesh.face_count()}};

@@ -18,6 +18,21 @@ void GrowthSettings::validate() const {
   check(snap_fraction >= 0 && snap_fraction < 0.5, "snap_fraction", snap_fraction, "[0, 0.5)");
 }
 
+double tip_domain_radius(const mesh::SkinnedMesh& mesh, const std::vector<std::uint8_t>& fixed,
+                         std::int32_t tip, double wanted) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (std::int32_t v = 0; v < mesh.vertex_count(); ++v)
+    if (fixed[std::size_t(v)])
+      nearest = std::min(nearest, (mesh.rest.col(v) - mesh.rest.col(tip)).norm());
+  return std::min(wanted, 0.5 * nearest);
+}
+
+Eigen::Vector3d growth_direction(const mesh::SkinnedMesh& mesh, const CrackTip& tip, double kink) {
+  const Eigen::Vector3d normal = sheet_normal(mesh, tip.vertex);
+  const Eigen::Vector3d e = tip.direction, n = normal.cross(e);
+  return std::cos(kink) * e + std::sin(kink) * n;
+}
+
 CrackedSheet::CrackedSheet(mesh::SkinnedMesh mesh, std::vector<std::uint8_t> fixed,
                            const std::vector<CrackTip>& tips, const SkinMaterial& material,
                            const SolverSettings& solver)
@@ -46,22 +61,11 @@ SolveReport CrackedSheet::solve() {
   return solver_.solve(model_, input, solver_settings_, x_);
 }
 
-double CrackedSheet::domain_radius(const CrackTip& tip, double wanted) const {
-  // q must vanish on the pinned vertices: the sheet's load is held there.
-  double nearest = std::numeric_limits<double>::infinity();
-  for (std::int32_t v = 0; v < mesh_.vertex_count(); ++v)
-    if (fixed_[std::size_t(v)])
-      nearest = std::min(nearest, (mesh_.rest.col(v) - mesh_.rest.col(tip.vertex)).norm());
-  return std::min(wanted, 0.5 * nearest);
-}
-
 bool CrackedSheet::extend(int i, const TipFracture& f, const GrowthSettings& s,
                           GrowthReport& report) {
   GrowingTip& g = tips_[std::size_t(i)];
-  const Eigen::Vector3d normal = sheet_normal(mesh_, g.tip.vertex);
-  const Eigen::Vector3d e = g.tip.direction, n = normal.cross(e);
   const double kink = mts_kink_angle(f.k1, f.k2);
-  const Eigen::Vector3d along = std::cos(kink) * e + std::sin(kink) * n;
+  const Eigen::Vector3d along = growth_direction(mesh_, g.tip, kink);
   const CrackExtension ext = crack_extension(mesh_, fixed_, g.tip.vertex, along, s.snap_fraction);
   if (ext.change.empty()) {
     g.stopped = true;  // the border, or a fan that cannot be split: the tear ends here
@@ -90,7 +94,8 @@ GrowthReport CrackedSheet::grow(const GrowthSettings& s) {
     for (std::size_t i = 0; i < tips_.size(); ++i) {
       if (tips_[i].stopped) continue;
       EnergyReleaseOptions domain = s.domain;
-      domain.domain_radius = domain_radius(tips_[i].tip, s.domain.domain_radius);
+      domain.domain_radius =
+          tip_domain_radius(mesh_, fixed_, tips_[i].tip.vertex, s.domain.domain_radius);
       judged.push_back({int(i), energy_release(mesh_, material_, x_, tips_[i].tip, domain), 0, 0});
     }
     if (first) report.first = judged;

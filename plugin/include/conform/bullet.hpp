@@ -9,3 +9,4 @@
 #include "conform/bullet/plugin.hpp"
 #include "conform/bullet/rigid_scalpel.hpp"
 #include "conform/bullet/skinned_soft_body.hpp"
+#include "conform/bullet/tear_growth.hpp"

@@ -55,6 +55,15 @@ struct GrowthReport {
   SolveReport solve;                      // the last solve (after the last extension)
 };
 
+/// The largest domain radius <= wanted around `tip` whose q vanishes on every fixed vertex
+/// (half the rest distance to the nearest one): the load is held there.
+double tip_domain_radius(const mesh::SkinnedMesh& mesh, const std::vector<std::uint8_t>& fixed,
+                         std::int32_t tip, double wanted);
+
+/// The direction the tip grows in (rest space, in the sheet's plane): the crack's direction e
+/// turned by `kink` (mts_kink_angle) toward n = N x e, N the sheet's normal at the tip.
+Eigen::Vector3d growth_direction(const mesh::SkinnedMesh& mesh, const CrackTip& tip, double kink);
+
 class CrackedSheet {
  public:
   /// `mesh`: the sheet with its cracks already made (rest positions; current ones unused);
@@ -79,7 +88,6 @@ class CrackedSheet {
  private:
   // One extension of tip i along its MTS direction; false when it stopped.
   bool extend(int i, const TipFracture& f, const GrowthSettings& s, GrowthReport& report);
-  double domain_radius(const CrackTip& tip, double wanted) const;
 
   mesh::SkinnedMesh mesh_;
   std::vector<std::uint8_t> fixed_;

@@ -47,6 +47,7 @@
 
 #include "conform/bullet/non_finite_state.hpp"
 #include "conform/bullet/piece.hpp"
+#include "conform/bullet/tear_growth.hpp"
 #include "conform/cga/plane.hpp"
 #include "conform/membrane/skin_material.hpp"
 #include "conform/membrane/solver_settings.hpp"
@@ -121,6 +122,9 @@ struct Material {
   membrane::SkinMaterial skin{};
   /// membrane: the solve of each substep (tolerance in Pa of nodal traction).
   membrane::SolverSettings solver{};
+  /// membrane: the tear's own growth by Griffith's criterion (tear_growth.hpp), off by
+  /// default; SkinnedSoftBody::grow_tear() runs it.
+  TearGrowthSettings growth{};
 };
 
 /// How a skinned body reaches its world (Plugin::add_skinned_body makes one).
@@ -227,6 +231,14 @@ class SkinnedSoftBody {
   void begin_tear(const mesh::TearOptions& options = {});
   mesh::TearStep tear_advance(const mesh::ScalpelSample& sample);
   const mesh::Tear* tear() const;
+  /// Grows the tear at its tips where the energy release rate reaches the skin's toughness
+  /// (tear_growth.hpp): nothing unless Material::growth is enabled, the model is the membrane
+  /// and a tear has begun. Call it between steps, e.g. after each stepSimulation. The blade may
+  /// cut first and growth follow; a blade step after a growth starts again from the blade's own
+  /// tip (growth then restarts from the tear's new ends).
+  TearGrowthReport grow_tear();
+  /// Rest-space length the tear has grown by itself since it began, m.
+  double tear_grown_length() const;
   /// Applies a change computed by the caller on mesh() (after sync_mesh()).
   void apply(const mesh::TopologyChange& change);
   const ApplyStats& last_apply() const;
