@@ -280,7 +280,8 @@ BENCHMARK(BM_OpeningTearStep)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 // The default material against two baselines in the same run: Bullet's pre-tensioned links
 // (the tear-opening scene's link settings, the default before the membrane) and the membrane
 // at its previous solver settings (1 Pa, block-Jacobi CG); and the membrane with its Newton
-// systems solved in place rather than packed (packed_systems off: the same results). The arm of `resolution` (1: 2.6k vertices, 2: 10k, 3: 23k).
+// systems solved in place rather than packed (packed_systems off: the same results). The arm of
+// `resolution` (1: 2.6k vertices, 2: 10k, 3: 23k).
 enum Variant { kLinks = 0, kMembrane = 1, kMembranePrevious = 2, kMembraneUnpacked = 3 };
 
 // The torn arm of tear-opening (its scene defaults: one 1/60 s substep a frame for the
@@ -296,11 +297,17 @@ struct TornArm {
   bool membrane;
   int next = 0;  // the next of the stroke's 40 samples
 
-  TornArm(int variant, int resolution, int threads, bool flexing = true)
+  /// toughness > 0: the tear grows by itself (Material::growth) at that G_c, J/m^2.
+  TornArm(int variant, int resolution, int threads, bool flexing = true, double toughness = 0)
       : membrane(variant != kLinks) {
     const mesh::Arm arm = mesh::make_arm(resolution);
     bullet::Material material;
     material.solver.threads = threads;
+    if (toughness > 0) {
+      material.skin.toughness = toughness;
+      material.growth.enabled = true;
+      material.growth.domain_radius = 0.015;  // tear-opening's tear.growth_radius
+    }
     if (variant == kMembranePrevious) {
       material.solver.relative_tolerance = 1.0 / material.skin.stress_scale();
       material.solver.preconditioner = membrane::Preconditioner::block_jacobi;
@@ -416,9 +423,61 @@ BENCHMARK(BM_TearArm)
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
 
+// One growth step of the torn arm's tear at resolution 1 (its G at both tips, the decision, the
+// crack extension and its mirror into Bullet: SkinnedSoftBody::grow_tear), against one scripted
+// tear step (a blade sample, computed and mirrored) on the same arm mid-stroke. The stroke is
+// done and settled; toughness 300 J/m^2 (G is about 560 there) makes both tips grow, 1e5 none.
+void BM_GrowthStepTornArm(benchmark::State& state) {
+  const double toughness = state.range(0) ? 300.0 : 1e5;
+  double grown = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto a = std::make_unique<TornArm>(kMembrane, 1, 1, false, toughness);
+    a->tear(40);
+    for (int i = 0; i < 20; ++i) a->frame();
+    state.ResumeTiming();
+    grown += a->body->grow_tear().grown;
+    state.PauseTiming();
+    a.reset();
+    state.ResumeTiming();
+  }
+  state.counters["grown_mm"] = 1e3 * grown / double(state.iterations());
+}
+BENCHMARK(BM_GrowthStepTornArm)
+    ->ArgNames({"grows"})
+    ->Arg(1)
+    ->Arg(0)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(10)
+    ->Repetitions(3);
+
+void BM_ScriptedTearStepTornArm(benchmark::State& state) {
+  for (auto _ : state) {
+    state.PauseTiming();
+    auto a = std::make_unique<TornArm>(kMembrane, 1, 1, false);
+    a->tear(20);
+    for (int i = 0; i < 20; ++i) a->frame();
+    state.ResumeTiming();
+    a->tear(1);
+    state.PauseTiming();
+    a.reset();
+    state.ResumeTiming();
+  }
+}
+BENCHMARK(BM_ScriptedTearStepTornArm)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(10)
+    ->Repetitions(3);
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  for (const char* grows : {"1", "0"})
+    conform::bench::add_ratio(
+        std::string("BM_GrowthStepTornArm/grows:") + grows + "/iterations:10/repeats:3",
+        "BM_ScriptedTearStepTornArm/iterations:10/repeats:3",
+        std::string("a growth step ") + (grows[0] == '1' ? "(both tips grow)" : "(judged only)") +
+            " / a scripted tear step, torn arm, resolution 1");
   for (const std::string bench : {"BM_StepTornArm", "BM_TearArm", "BM_StillTornArm"})
     for (const std::string r : {"1", "2", "3"}) {
       const auto name = [&](int variant, const char* threads) {
