@@ -10,6 +10,9 @@
 #include "conform/membrane/crack_extension.hpp"
 #include "conform/membrane/crack_growth.hpp"
 #include "conform/membrane/slit_sheet.hpp"
+#include "conform/mesh/adjacency.hpp"
+#include "conform/mesh/primitives.hpp"
+#include "conform/mesh/tear.hpp"
 
 namespace conform::membrane {
 namespace {
@@ -104,6 +107,60 @@ TEST(MembraneCrackGrowth, AnExtensionOpensTheOldTip) {
     copies += (s.mesh.rest.col(v) - at).norm() == 0;
   EXPECT_EQ(copies, 2);
   EXPECT_GT((s.mesh.rest.col(e.new_tip) - at).x(), 0);
+  EXPECT_EQ((s.mesh.rest.col(e.duplicate) - at).norm(), 0);
+  EXPECT_NE(e.duplicate, tip);
+}
+
+// A blade's tear takes a grown segment at either end: its borders run on to the new tip, each
+// on its own side, and the blade cuts on from there.
+TEST(MembraneCrackGrowth, ATearAdoptsGrowthAtEitherEnd) {
+  mesh::SkinnedMesh sheet = mesh::make_sheet(40, 40, 0.4, 0.4);
+  mesh::Adjacency adjacency(sheet);
+  mesh::Tear tear(sheet, adjacency);
+  const double y = 0.00123;
+  for (int i = 0; i < 11; ++i) {
+    const double x = -0.05 + 0.01 * i;
+    tear.advance({double(i), {x, y, -0.1}, {x, y, 0.1}});
+  }
+  ASSERT_GT(tear.path_length(), 3) << tear.message();
+  const std::int32_t points = tear.path_length();
+  for (const bool at_tip : {true, false}) {
+    const std::vector<std::int32_t> border = tear.right_border();
+    const std::int32_t end = at_tip ? border.back() : border.front();
+    const Eigen::Vector3d ahead(at_tip ? 1 : -1, 0, 0);
+    const std::vector<std::uint8_t> none(std::size_t(sheet.vertex_count()), 0);
+    const CrackExtension e = crack_extension(sheet, none, end, ahead);
+    ASSERT_FALSE(e.change.empty()) << e.message;
+    mesh::apply(sheet, e.change, &adjacency);
+    tear.adopt_growth(end, e.duplicate, e.new_tip);
+    const std::vector<std::int32_t> right = tear.right_border(), left = tear.left_border();
+    EXPECT_EQ(at_tip ? right.back() : right.front(), e.new_tip);
+    EXPECT_EQ(at_tip ? left.back() : left.front(), e.new_tip);
+    // The right copies lie in the faces on one side of the path, the left ones on the other.
+    const auto face_y = [&](std::int32_t v) {
+      double y = 0;
+      int n = 0;
+      for (const mesh::Face& f : sheet.faces)
+        if (f[0] == v || f[1] == v || f[2] == v)
+          y += sheet.rest(1, f[0]) + sheet.rest(1, f[1]) + sheet.rest(1, f[2]), n += 3;
+      return y / n;
+    };
+    const double side = face_y(left[1]) - face_y(right[1]);
+    for (std::size_t i = 1; i + 1 < right.size(); ++i) {
+      EXPECT_NE(left[i], right[i]) << i;
+      EXPECT_GT(side * (face_y(left[i]) - face_y(right[i])), 0) << i;
+    }
+  }
+  EXPECT_EQ(tear.path_length(), points + 2);
+  EXPECT_THROW(tear.adopt_growth(tear.right_border()[2], 0, 1), std::invalid_argument);
+  // The blade cuts on from the grown tip.
+  const double from = sheet.rest(0, tear.right_border().back());
+  for (int i = 1; i <= 3; ++i) {
+    const double x = from + 0.01 * i;
+    tear.advance({double(20 + i), {x, y, -0.1}, {x, y, 0.1}});
+  }
+  EXPECT_GT(tear.path_length(), points + 2) << tear.message();
+  EXPECT_GT(sheet.rest(0, tear.right_border().back()), from);
 }
 
 }  // namespace

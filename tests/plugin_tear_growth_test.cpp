@@ -174,6 +174,46 @@ TEST(PluginTearGrowth, TipsGrowStraightAheadWhereGReachesToughnessKeepingMassAnd
     ASSERT_TRUE(body.position(v).allFinite()) << v;
 }
 
+TEST(PluginTearGrowth, BladeAndGrowthActOnOneTear) {
+  Torn t;
+  tear_sheet(t, sheet_material(1e-3));  // every judgement grows
+  bullet::SkinnedSoftBody& body = *t.body;
+  const double mass = body.total_mass();
+  const std::int32_t points = body.tear()->path_length();
+  const bullet::TearGrowthReport grown = body.grow_tear();
+  ASSERT_GT(grown.grown, 0);
+  // The tear takes the grown segments: its ends are the grown tips.
+  EXPECT_EQ(body.tear()->path_length(), points + 2);
+  const std::int32_t tip = body.tear()->right_border().back();
+  EXPECT_EQ(body.tear()->left_border().back(), tip);
+  EXPECT_GT(body.mesh().rest(0, tip), t.half_length);
+  t.w.step(2);
+  // The blade cuts on from the grown tip; the growth then judges the blade's new tip.
+  const double from = body.mesh().rest(0, tip);
+  for (int i = 0; i < 6; ++i) {
+    const double x = from + 0.002 * (i + 1);
+    body.tear_advance({double(20 + i), {x, kTearY, -0.1}, {x, kTearY, 0.1}});
+  }
+  EXPECT_GT(body.tear()->path_length(), points + 2) << body.tear()->message();
+  EXPECT_GT(body.mesh().rest(0, body.tear()->right_border().back()), from + 0.008);
+  const bullet::TearGrowthReport after = body.grow_tear();
+  ASSERT_EQ(after.tips.size(), 2u);
+  EXPECT_EQ(after.tips[1].vertex, body.tear()->right_border().back());
+  EXPECT_GT(after.grown, 0);
+  t.w.step(10);
+  EXPECT_LT(std::abs(body.total_mass() - mass) / mass, 1e-9);
+  for (std::int32_t v = 0; v < body.vertex_count(); ++v)
+    ASSERT_TRUE(body.position(v).allFinite()) << v;
+  // Both borders stay chains of distinct copies between the shared ends, each on its own side.
+  const auto left = body.tear()->left_border(), right = body.tear()->right_border();
+  ASSERT_EQ(left.size(), right.size());
+  const double side = body.position(left[1]).y() - body.position(right[1]).y();
+  for (std::size_t i = 1; i + 1 < left.size(); ++i) {
+    EXPECT_NE(left[i], right[i]) << i;
+    EXPECT_GT(side * (body.position(left[i]).y() - body.position(right[i]).y()), 0) << i;
+  }
+}
+
 TEST(PluginTearGrowth, NoGrowthBelowToughness) {
   Torn t;
   tear_sheet(t, sheet_material(1e6));

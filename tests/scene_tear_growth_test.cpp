@@ -66,6 +66,8 @@ TEST(SceneTearGrowth, IncisionGrowsDuringTheFlexAboveItsStillGAndNotAtTenTimesIt
             grows["settings"]["pose"]["flex_at"].get<double>());
   EXPECT_GT(g["max_energy_release_rate"].get<double>(), 600);
   EXPECT_EQ(g["toughness"].get<double>(), 600);
+  EXPECT_LT(g["growth_mass_error"].get<double>(), 1e-9);
+  EXPECT_LT(g["growth_momentum_error"].get<double>(), 1e-9);
   const Json& h = holds["metrics"]["physics"];
   EXPECT_EQ(h["grown_length"].get<double>(), 0);
   EXPECT_LT(h["max_energy_release_rate"].get<double>(), 6000);

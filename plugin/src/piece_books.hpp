@@ -66,10 +66,10 @@ struct SkinnedSoftBody::Impl::Piece {
   std::vector<std::uint8_t> link_bend;                          // link → 1 for a bending link
   std::vector<std::int32_t> face_id;                            // Bullet face slot → mesh face
   std::int32_t bending = 0;                                     // bending links in this body
-  bool reapply = true;       // rest lengths to write at the next update (set when built)
-  PieceSettings settings;    // inherited by the pieces split from it
-  bool released = false;     // released from skinning (release_piece): not driven
-  ReleaseOptions release{};  // how, when released
+  bool reapply = true;        // rest lengths to write at the next update (set when built)
+  PieceSettings settings;     // inherited by the pieces split from it
+  bool released = false;      // released from skinning (release_piece): not driven
+  ReleaseOptions release{};   // how, when released
   double release_volume = 0;  // V0, m³: the closed piece's volume at release (0: open)
 };
 

@@ -394,7 +394,7 @@ const mesh::Tear* SkinnedSoftBody::tear() const {
 }
 TearGrowthReport SkinnedSoftBody::grow_tear() {
   impl_->check_editable("grow_tear");
-  return impl_->growth_.grow(*this);
+  return impl_->growth_.grow(*this, impl_->tear_.get());
 }
 double SkinnedSoftBody::tear_grown_length() const {
   return impl_->growth_.grown();

@@ -229,7 +229,7 @@ struct SkinnedSoftBody::Impl {
   Material material_;
   std::unique_ptr<mesh::Tear> tear_;
   TearGrowth growth_;  // the tear's own growth (Material::growth)
-  SkinDrive drive_;  // after skeleton_, which it reads
+  SkinDrive drive_;    // after skeleton_, which it reads
   MembraneDrive membrane_;
   std::vector<void*> vertex_node_;  // per vertex: its btSoftBody::Node (null when detached)
   Eigen::Matrix3Xd target_matrix_, previous_matrix_;

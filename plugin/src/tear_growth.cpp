@@ -109,7 +109,7 @@ TipGrowth TearGrowth::judge(const SkinnedSoftBody& body, const std::vector<std::
   return out;
 }
 
-void TearGrowth::extend(SkinnedSoftBody& body, std::size_t i, TipGrowth& judged) {
+void TearGrowth::extend(SkinnedSoftBody& body, mesh::Tear& tear, std::size_t i, TipGrowth& judged) {
   Tip& tip = tips_[i];
   const mesh::SkinnedMesh& mesh = body.mesh();
   const Eigen::Vector3d along = membrane::growth_direction(mesh, tip.crack, judged.kink);
@@ -122,16 +122,17 @@ void TearGrowth::extend(SkinnedSoftBody& body, std::size_t i, TipGrowth& judged)
   }
   const Eigen::Vector3d from = mesh.rest.col(tip.crack.vertex);
   body.apply(ext.change);
+  tear.adopt_growth(tip.crack.vertex, ext.duplicate, ext.new_tip);
+  tear_points_ = tear.path_length();
   const Eigen::Vector3d to = body.mesh().rest.col(ext.new_tip);
   judged.extended = (to - from).norm();
   tip.crack = {ext.new_tip, (to - from) / judged.extended};
   grown_ += judged.extended;
 }
 
-TearGrowthReport TearGrowth::grow(SkinnedSoftBody& body) {
+TearGrowthReport TearGrowth::grow(SkinnedSoftBody& body, mesh::Tear* tear) {
   TearGrowthReport report;
   const Material& m = body.material();
-  const mesh::Tear* tear = body.tear();
   if (!m.growth.enabled || m.model != MaterialModel::membrane || !tear || tear->path_length() < 2)
     return report;
   const double start = thread_seconds();
@@ -146,7 +147,7 @@ TearGrowthReport TearGrowth::grow(SkinnedSoftBody& body) {
   for (std::size_t k = 0; k < running.size(); ++k) {
     TipGrowth& judged = report.tips[k];
     if (judged.energy_release_rate < m.skin.toughness) continue;
-    extend(body, running[k], judged);
+    extend(body, *tear, running[k], judged);
     report.grown += judged.extended;
   }
   report.seconds = thread_seconds() - start;

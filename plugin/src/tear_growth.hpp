@@ -20,8 +20,9 @@ class SkinnedSoftBody;
 
 class TearGrowth {
  public:
-  /// One growth step of `body`'s tear (SkinnedSoftBody::grow_tear).
-  TearGrowthReport grow(SkinnedSoftBody& body);
+  /// One growth step of `body`'s tear (SkinnedSoftBody::grow_tear); `tear` is that tear, which
+  /// takes each grown segment (mesh::Tear::adopt_growth).
+  TearGrowthReport grow(SkinnedSoftBody& body, mesh::Tear* tear);
   /// Rest-space length grown since the tear began, m.
   double grown() const { return grown_; }
 
@@ -34,7 +35,7 @@ class TearGrowth {
   void follow_tear(const SkinnedSoftBody& body);
   TipGrowth judge(const SkinnedSoftBody& body, const std::vector<std::uint8_t>& fixed,
                   std::size_t i) const;
-  void extend(SkinnedSoftBody& body, std::size_t i, TipGrowth& judged);
+  void extend(SkinnedSoftBody& body, mesh::Tear& tear, std::size_t i, TipGrowth& judged);
 
   std::vector<Tip> tips_;
   const mesh::Tear* tear_ = nullptr;

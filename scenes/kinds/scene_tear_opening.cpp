@@ -35,7 +35,7 @@ namespace {
 // tear-opening`).
 constexpr const char* kTearOpeningJson = R"json({
   "scene": "tear-opening",
-  "description": "The procedural arm as a CGA-skinned Bullet soft body whose skin is a pre-stressed membrane in SI units (human skin: E 0.42 MPa, 1.5 mm, 10 % pre-strain) attached to the skinned targets, torn along the forearm by a scalpel stroke; the same stroke on the posed mesh alone is opened by Algorithm 2 step 6. Compares the gap-width profiles over time. material.model = bullet_links runs Bullet's pre-tensioned links instead (the link keys below).",
+  "description": "The procedural arm as a CGA-skinned Bullet soft body whose skin is a pre-stressed membrane in SI units (human skin: E 0.42 MPa, 1.5 mm, 10 % pre-strain) attached to the skinned targets, torn along the forearm by a scalpel stroke; the same stroke on the posed mesh alone is opened by Algorithm 2 step 6. Compares the gap-width profiles over time. tear.growth lets the physical incision grow by itself once the stroke is done, where its energy release rate reaches material.toughness. material.model = bullet_links runs Bullet's pre-tensioned links instead (the link keys below).",
   "seed": 1,
   "duration": 3.0,
   "model": { "resolution": 1 },
@@ -188,6 +188,7 @@ class TearOpening final : public Scene {
     int tear_steps = 0;
     // The tear's own growth: G at its tips at the last judgement and over the run, J/m^2.
     double g_now = 0, g_max = 0, growth_ms = 0, growth_onset = -1;
+    double growth_mass_error = 0, growth_momentum_error = 0;  // relative, worst growth step
     int growth_steps = 0;
     double worst_residual = 0, before_flex = -1;  // the membrane's solves; the opening then
     int unconverged = 0;
@@ -280,8 +281,17 @@ class TearOpening final : public Scene {
   // it first grew.
   void grow(TearRun& r, double t) const {
     if (!material_.growth.enabled) return;
+    const double mass = r.body.total_mass();
+    const Vec3 momentum = r.body.momentum();
     bullet::TearGrowthReport report;
     r.growth_ms += milliseconds([&] { report = r.body.grow_tear(); });
+    if (report.grown > 0) {  // a growth step conserves mass and momentum like any edit
+      r.growth_mass_error =
+          std::max(r.growth_mass_error, std::abs(r.body.total_mass() - mass) / mass);
+      r.growth_momentum_error =
+          std::max(r.growth_momentum_error, (r.body.momentum() - momentum).norm() /
+                                                std::max(r.body.momentum_scale(), 1e-300));
+    }
     ++r.growth_steps;
     r.g_now = 0;
     for (const bullet::TipGrowth& tip : report.tips)
@@ -365,6 +375,8 @@ class TearOpening final : public Scene {
     metrics["physics"]["max_energy_release_rate"] = r.g_max;
     metrics["physics"]["toughness"] = material_.skin.toughness;
     metrics["physics"]["growth_onset_time"] = r.growth_onset;
+    metrics["physics"]["growth_mass_error"] = r.growth_mass_error;
+    metrics["physics"]["growth_momentum_error"] = r.growth_momentum_error;
     metrics["physics"]["material"] =
         material_.model == bullet::MaterialModel::membrane ? "membrane" : "bullet_links";
     metrics["tear_direction"] = across_ ? "across" : "along";

@@ -138,6 +138,7 @@ CrackExtension crack_extension(const mesh::SkinnedMesh& m, const std::vector<std
   }
   for (const LocalFace& a : across) ch.added_faces.push_back(a.face);
   out.new_tip = q;
+  out.duplicate = duplicate;
   return out;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include "change_flips.hpp"
 #include "tear_opening.hpp"
@@ -187,6 +188,47 @@ TearStep Tear::advance(const ScalpelSample& s) {
   tearing::TearAdvance(*this, s, step).run();
   previous_ = s;
   return step;
+}
+
+void Tear::adopt_growth(std::int32_t end, std::int32_t duplicate, std::int32_t new_tip) {
+  const bool at_tip = path_.size() >= 2 && end == tip_;
+  const bool at_start = path_.size() >= 2 && end == path_.front().right;
+  if (!at_tip && !at_start)
+    throw std::invalid_argument("tear: vertex " + std::to_string(end) +
+                                " is not an end of the tear");
+  // The end's copy on the right border is the one sharing a face with the neighbouring point's
+  // right copy; the normal points from the right copy's faces toward the left one's.
+  const PathVertex& next = at_tip ? path_[path_.size() - 2] : path_[1];
+  const auto shares_face = [&](std::int32_t u, std::int32_t v) {
+    return adjacency_.find(u, v) >= 0 || adjacency_.find(v, u) >= 0;
+  };
+  const std::int32_t right = shares_face(next.right, duplicate) ? duplicate : end;
+  const std::int32_t left = right == duplicate ? end : duplicate;
+  const auto centroid = [&](std::int32_t v) {  // of the faces around v
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    int n = 0;
+    for (const Face& f : mesh_.faces)
+      if (f[0] == v || f[1] == v || f[2] == v) {
+        c += mesh_.current.col(f[0]) + mesh_.current.col(f[1]) + mesh_.current.col(f[2]);
+        n += 3;
+      }
+    return Eigen::Vector3d(c / std::max(n, 1));
+  };
+  const Eigen::Vector3d along = mesh_.current.col(new_tip) - mesh_.current.col(end);
+  Eigen::Vector3d normal = centroid(left) - centroid(right);
+  normal -= normal.dot(along) / along.squaredNorm() * along;
+  const PathVertex grown{right, left, normal.normalized()};
+  if (at_tip) {
+    path_.back() = grown;
+    path_.push_back({new_tip, -1, Eigen::Vector3d::Zero()});
+    tip_ = new_tip;
+    tip_neighbor_ = right;
+    tip_target_ = mesh_.current.col(new_tip);
+    tip_off_track_ = false;
+  } else {
+    path_.front() = grown;
+    path_.insert(path_.begin(), {new_tip, -1, Eigen::Vector3d::Zero()});
+  }
 }
 
 double Tear::length() const {

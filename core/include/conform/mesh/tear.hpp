@@ -89,6 +89,12 @@ class Tear {
   /// (vertex, offset) it applied.
   std::vector<std::pair<std::int32_t, Eigen::Vector3d>> open(double amount);
 
+  /// The crack grew by itself from one of the tear's ends (a change applied to the mesh, its
+  /// adjacency and index already): `end` was duplicated into `duplicate` and the crack runs on to
+  /// `new_tip`. The path takes the grown segment, so the borders, open() and the blade's next
+  /// step start from there. Throws std::invalid_argument when `end` is not an end of the tear.
+  void adopt_growth(std::int32_t end, std::int32_t duplicate, std::int32_t new_tip);
+
   bool started() const { return tip_ >= 0; }
   int steps() const { return steps_; }
   /// Points of the tear (start, interior points, tip).

@@ -30,6 +30,7 @@ namespace conform::membrane {
 struct CrackExtension {
   mesh::TopologyChange change;  // empty when the crack did not grow
   std::int32_t new_tip = -1;    // the new tip's vertex index after the change
+  std::int32_t duplicate = -1;  // the old tip's copy, which takes the faces left of the path
   bool reached_border = false;
   std::string message;  // why it did not grow (empty when it did)
 };

@@ -233,9 +233,9 @@ class SkinnedSoftBody {
   const mesh::Tear* tear() const;
   /// Grows the tear at its tips where the energy release rate reaches the skin's toughness
   /// (tear_growth.hpp): nothing unless Material::growth is enabled, the model is the membrane
-  /// and a tear has begun. Call it between steps, e.g. after each stepSimulation. The blade may
-  /// cut first and growth follow; a blade step after a growth starts again from the blade's own
-  /// tip (growth then restarts from the tear's new ends).
+  /// and a tear has begun. Call it between steps, e.g. after each stepSimulation. The tear takes
+  /// each grown segment (tear() then includes it), so a blade and growth can act on one tear in
+  /// any order: the blade cuts on from a grown tip, and growth judges the blade's tip.
   TearGrowthReport grow_tear();
   /// Rest-space length the tear has grown by itself since it began, m.
   double tear_grown_length() const;
