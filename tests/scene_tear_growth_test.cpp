@@ -49,6 +49,12 @@ TEST(SceneTearGrowth, ArmsEnergyReleaseRateIsTheFoundationsAndConverged) {
   EXPECT_NEAR(g1 / reference, 1.0, 0.10);
   EXPECT_NEAR(g2 / g1, 1.0, 0.03);
   EXPECT_EQ(coarse["metrics"]["physics"]["grown_length"].get<double>(), 0);
+  // Both tips are reported, each with its mode mix (G = (K_I^2 + K_II^2) / E' by construction).
+  ASSERT_EQ(coarse["metrics"]["physics"]["tips"].size(), 2u);
+  for (const Json& tip : coarse["metrics"]["physics"]["tips"]) {
+    EXPECT_GT(tip["energy_release_rate"].get<double>(), 0);
+    EXPECT_GT(tip["k1"].get<double>(), 0);
+  }
 }
 
 TEST(SceneTearGrowth, IncisionGrowsDuringTheFlexAboveItsStillGAndNotAtTenTimesIt) {

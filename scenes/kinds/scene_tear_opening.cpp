@@ -189,6 +189,7 @@ class TearOpening final : public Scene {
     // The tear's own growth: G at its tips at the last judgement and over the run, J/m^2.
     double g_now = 0, g_max = 0, growth_ms = 0, growth_onset = -1;
     double growth_mass_error = 0, growth_momentum_error = 0;  // relative, worst growth step
+    std::vector<bullet::TipGrowth> last_tips;                 // the last judgement of the tips
     int growth_steps = 0;
     double worst_residual = 0, before_flex = -1;  // the membrane's solves; the opening then
     int unconverged = 0;
@@ -296,6 +297,7 @@ class TearOpening final : public Scene {
     r.g_now = 0;
     for (const bullet::TipGrowth& tip : report.tips)
       r.g_now = std::max(r.g_now, tip.energy_release_rate);
+    if (!report.tips.empty()) r.last_tips = report.tips;
     r.g_max = std::max(r.g_max, r.g_now);
     if (report.grown > 0 && r.growth_onset < 0) r.growth_onset = t;
   }
@@ -375,6 +377,7 @@ class TearOpening final : public Scene {
     metrics["physics"]["max_energy_release_rate"] = r.g_max;
     metrics["physics"]["toughness"] = material_.skin.toughness;
     metrics["physics"]["growth_onset_time"] = r.growth_onset;
+    metrics["physics"]["tips"] = tips_json(r.last_tips);
     metrics["physics"]["growth_mass_error"] = r.growth_mass_error;
     metrics["physics"]["growth_momentum_error"] = r.growth_momentum_error;
     metrics["physics"]["material"] =
@@ -384,6 +387,20 @@ class TearOpening final : public Scene {
     metrics["nodes"] = r.body.vertex_count();
     metrics["units"] = "metres, square metres; profile_r2 of w_max*sqrt(1-(2s-1)^2)";
     return metrics;
+  }
+
+  // Each tip's last judgement: G (J/m^2), K_I and K_II (Pa m^1/2), the kink (degrees).
+  static Json tips_json(const std::vector<bullet::TipGrowth>& tips) {
+    Json out = Json::array();
+    for (const bullet::TipGrowth& t : tips)
+      out.push_back({{"vertex", t.vertex},
+                     {"energy_release_rate", t.energy_release_rate},
+                     {"k1", t.k1},
+                     {"k2", t.k2},
+                     {"kink_deg", t.kink * 180 / std::numbers::pi},
+                     {"domain_radius", t.domain_radius},
+                     {"stopped", t.stopped}});
+    return out;
   }
 
   Json timings(const TearRun& r) const {
