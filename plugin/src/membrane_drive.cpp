@@ -21,10 +21,10 @@ void MembraneDrive::target_normals(const mesh::SkinnedMesh& mesh,
 }
 
 membrane::SolveReport MembraneDrive::step(
-    const mesh::SkinnedMesh& mesh, const membrane::SkinMaterial& material,
-    const membrane::SolverSettings& settings, std::span<void* const> nodes,
-    std::span<const std::uint8_t> fixed, std::span<const double> masses,
-    const Eigen::Ref<const Eigen::Matrix3Xd>& targets,
+    const mesh::SkinnedMesh& mesh, const Eigen::Ref<const Eigen::Matrix3Xd>& rest,
+    const membrane::SkinMaterial& material, const membrane::SolverSettings& settings,
+    std::span<void* const> nodes, std::span<const std::uint8_t> fixed,
+    std::span<const double> masses, const Eigen::Ref<const Eigen::Matrix3Xd>& targets,
     const Eigen::Ref<const Eigen::Matrix3Xd>& previous_targets, double dt) {
   const Eigen::Index nv = mesh.vertex_count();
   // The last solution in double precision carries over while the mesh is unchanged. Bullet
@@ -37,7 +37,7 @@ membrane::SolveReport MembraneDrive::step(
   if (stale_ || model_.vertex_count() != nv) {
     const bool by_bones = material.prestress_field != membrane::SkinMaterial::DirectionField::axis;
     if (by_bones) limb_axes_ = skin::vertex_limb_axes(mesh, bone_axes_);
-    model_.build(mesh.rest, mesh.faces, material, by_bones ? &limb_axes_ : nullptr);
+    model_.build(rest, mesh.faces, material, by_bones ? &limb_axes_ : nullptr);
     stale_ = false;
   }
   x_.resize(3, nv);

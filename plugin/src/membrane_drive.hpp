@@ -4,8 +4,8 @@
 // inertia and damping, solved to a residual; the nodes then carry the result (position and
 // velocity), so Bullet's contacts and collisions act on it as before.
 //
-// The membrane's elements are rebuilt from the mesh's REST configuration after a topology
-// change (O(#F) once per change, paid at the next substep), never from the current shape.
+// The membrane's elements are rebuilt from the skin's REST configuration (the bind pose) after a
+// topology change (O(#F) once per change, paid at the next substep), never from the current shape.
 #pragma once
 
 #include <Eigen/Core>
@@ -29,10 +29,13 @@ class MembraneDrive {
   /// The skeleton's bone axes (skin::bone_axes), which the along_bones and around_bones
   /// pre-stress fields follow through each vertex's weights.
   void set_bone_axes(std::vector<Eigen::Vector3d> axes) { bone_axes_ = std::move(axes); }
-  /// One substep. `nodes` per vertex (null for a vertex outside Bullet); `fixed` per vertex
-  /// (kinematic or pinned: left where Bullet put them); masses, targets and previous targets
-  /// per vertex.
-  membrane::SolveReport step(const mesh::SkinnedMesh& mesh, const membrane::SkinMaterial& material,
+  /// One substep. `rest`: the skin's rest state per vertex (the bind pose, SkinDrive::bind_pose),
+  /// read when the model is rebuilt. `nodes` per vertex (null for a vertex outside Bullet); `fixed`
+  /// per vertex (kinematic or pinned: left where Bullet put them); masses, targets and previous
+  /// targets per vertex.
+  membrane::SolveReport step(const mesh::SkinnedMesh& mesh,
+                             const Eigen::Ref<const Eigen::Matrix3Xd>& rest,
+                             const membrane::SkinMaterial& material,
                              const membrane::SolverSettings& settings, std::span<void* const> nodes,
                              std::span<const std::uint8_t> fixed, std::span<const double> masses,
                              const Eigen::Ref<const Eigen::Matrix3Xd>& targets,

@@ -2,6 +2,8 @@
 // drives the Bullet nodes toward them (Impl::update).
 #include "skin_drive.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -54,6 +56,22 @@ void SkinDrive::start(const mesh::SkinnedMesh& mesh) {
   rebuild_inputs(mesh);
   skin(mesh, 0);
   previous_ = target_;
+}
+
+Eigen::Matrix3Xd SkinDrive::bind_pose(const mesh::SkinnedMesh& mesh) const {
+  skin::Skinner<double> skinner(*skeleton_, mesh.rest, skin::Influences<double>::from_mesh(mesh));
+  skin::SoaPoints<double> bind;
+  skinner.skin(skin::Pose::rest(*skeleton_), skin::SkinMode::cga, bind);
+  Eigen::Matrix3Xd out(3, mesh.vertex_count());
+  double apart = 0;
+  for (Eigen::Index v = 0; v < out.cols(); ++v) {
+    const auto i = static_cast<std::size_t>(v);
+    out.col(v) << bind.x[i], bind.y[i], bind.z[i];
+    apart = std::max(apart, (out.col(v) - mesh.rest.col(v)).norm());
+  }
+  if (mesh.vertex_count() == 0) return out;
+  const double size = (mesh.rest.rowwise().maxCoeff() - mesh.rest.rowwise().minCoeff()).norm();
+  return apart <= 1e-9 * size ? Eigen::Matrix3Xd() : out;
 }
 
 void SkinDrive::rebuild_inputs(const mesh::SkinnedMesh& mesh) {
@@ -175,8 +193,8 @@ void SkinnedSoftBody::Impl::step_membrane(double dt) {
       node.m_v = (t - node.m_q) / btScalar(dt);
     }
   }
-  membrane_.step(mesh_, material_.skin, material_.solver, vertex_node_, kinematic_, mass_,
-                 target_matrix_, previous_matrix_, dt);
+  membrane_.step(mesh_, skin_rest(), material_.skin, material_.solver, vertex_node_, kinematic_,
+                 mass_, target_matrix_, previous_matrix_, dt);
 }
 
 void SkinnedSoftBody::Impl::drive_nodes(Piece& piece, double dt) {

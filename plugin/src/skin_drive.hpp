@@ -44,6 +44,11 @@ class SkinDrive {
   /// After an edit added vertices: their targets now (the last pose, the source not asked
   /// again), their previous targets equal to them, so that target(v) is valid at once.
   void extend(const mesh::SkinnedMesh& mesh);
+  /// The bind pose: the rest points skinned at the skeleton's rest pose, model space (no world
+  /// transform), 3 x #V. An imported mesh's rest points are in its mesh space, which need not
+  /// be the bind pose's (huesitos.fbx: 100 times smaller); the skin's rest state is the bind
+  /// pose. Empty where the two agree to 1e-9 of the mesh's size: the rest points are it.
+  Eigen::Matrix3Xd bind_pose(const mesh::SkinnedMesh& mesh) const;
   /// The targets at `time` become the previous ones too (zero target velocity).
   void settle(const mesh::SkinnedMesh& mesh, double time) {
     skin(mesh, time);

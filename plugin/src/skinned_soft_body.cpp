@@ -150,6 +150,7 @@ SkinnedSoftBody::Impl::Impl(const WorldLink& link, const mesh::SkinnedMesh& mesh
   for (std::int32_t v = 0; v < n; ++v)
     kinematic_[static_cast<std::size_t>(v)] = is_kinematic_by_weight(v);
   drive_.start(mesh_);
+  bind_ = drive_.bind_pose(mesh_);
   build(mesh_);
 }
 
@@ -225,7 +226,7 @@ mesh::DrillResult SkinnedSoftBody::Impl::drill(const mesh::DrillTool& tool,
 void SkinnedSoftBody::Impl::begin_tear(const mesh::TearOptions& options) {
   check_editable("begin_tear");
   tear_ = std::make_unique<mesh::Tear>(mesh_, adjacency_, face_index_, options);
-  growth_ = {};
+  growth_.reset();
   blade_.reset();
 }
 

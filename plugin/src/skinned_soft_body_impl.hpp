@@ -78,6 +78,11 @@ struct SkinnedSoftBody::Impl {
   const mesh::SkinnedMesh& mesh() const { return mesh_; }
   const skin::Skeleton& skeleton() const { return skeleton_; }
   const Material& material() const { return material_; }
+  /// The skin's rest state per vertex: the bind pose (the membrane's and growth's rest frame).
+  Eigen::Ref<const Eigen::Matrix3Xd> skin_rest() const {
+    if (bind_.cols() > 0) return bind_;
+    return mesh_.rest;
+  }
   void sync_mesh();
   std::int32_t vertex_count() const { return mesh_.vertex_count(); }
   std::int32_t piece_count() const;
@@ -228,9 +233,11 @@ struct SkinnedSoftBody::Impl {
   skin::Skeleton skeleton_;
   Material material_;
   std::unique_ptr<mesh::Tear> tear_;
-  TearGrowth growth_;  // the tear's own growth (Material::growth)
-  SkinDrive drive_;    // after skeleton_, which it reads
+  TearGrowth growth_{[this] { return skin_rest(); }};  // the tear's own growth
+  SkinDrive drive_;                                    // after skeleton_, which it reads
   MembraneDrive membrane_;
+  // The bind pose where the mesh's rest points are not it (SkinDrive::bind_pose), else empty.
+  Eigen::Matrix3Xd bind_;
   std::vector<void*> vertex_node_;  // per vertex: its btSoftBody::Node (null when detached)
   Eigen::Matrix3Xd target_matrix_, previous_matrix_;
   std::vector<btVector3> volume_gradient_;  // hold_released_volumes' ∂V/∂x_i, reused

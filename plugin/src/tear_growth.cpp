@@ -40,9 +40,8 @@ Eigen::Vector3d end_direction(const mesh::SkinnedMesh& mesh, const std::vector<s
 // skinned targets of the vertices within `radius` (rest) onto their rest positions (Umeyama,
 // no scale) applied to every position. The energy does not change under it; the lips'
 // displacement correlation then reads opening and sliding in the rest frame's n and e.
-Eigen::Matrix3Xd rest_frame_positions(const SkinnedSoftBody& body, const Eigen::Vector3d& at,
-                                      double radius) {
-  const mesh::SkinnedMesh& mesh = body.mesh();
+Eigen::Matrix3Xd rest_frame_positions(const SkinnedSoftBody& body, const mesh::SkinnedMesh& mesh,
+                                      const Eigen::Vector3d& at, double radius) {
   std::vector<std::int32_t> near;
   for (std::int32_t v = 0; v < mesh.vertex_count(); ++v)
     if ((mesh.rest.col(v) - at).norm() <= radius && !body.detached(v)) near.push_back(v);
@@ -72,6 +71,14 @@ void TearGrowthSettings::validate() const {
   require(snap_fraction >= 0 && snap_fraction < 0.5, "snap_fraction", snap_fraction, "[0, 0.5)");
 }
 
+const mesh::SkinnedMesh& TearGrowth::skin_mesh(const SkinnedSoftBody& body) {
+  const Eigen::Ref<const Eigen::Matrix3Xd> rest = skin_rest_();
+  if (rest.data() == body.mesh().rest.data()) return body.mesh();
+  view_ = body.mesh();
+  view_.rest = rest;
+  return view_;
+}
+
 void TearGrowth::follow_tear(const SkinnedSoftBody& body) {
   const mesh::Tear* tear = body.tear();
   if (tear != tear_) grown_ = 0;
@@ -79,15 +86,16 @@ void TearGrowth::follow_tear(const SkinnedSoftBody& body) {
   tear_ = tear, tear_points_ = tear->path_length();
   std::vector<std::int32_t> border = tear->right_border();
   const double chord = 0.5 * body.material().growth.domain_radius;
-  const Eigen::Vector3d start = end_direction(body.mesh(), border, chord);
+  const mesh::SkinnedMesh& mesh = skin_mesh(body);
+  const Eigen::Vector3d start = end_direction(mesh, border, chord);
   std::reverse(border.begin(), border.end());
-  const Eigen::Vector3d tip = end_direction(body.mesh(), border, chord);
+  const Eigen::Vector3d tip = end_direction(mesh, border, chord);
   tips_ = {{{border.back(), start}}, {{border.front(), tip}}};
 }
 
 TipGrowth TearGrowth::judge(const SkinnedSoftBody& body, const std::vector<std::uint8_t>& fixed,
-                            std::size_t i) const {
-  const mesh::SkinnedMesh& mesh = body.mesh();
+                            std::size_t i) {
+  const mesh::SkinnedMesh& mesh = skin_mesh(body);
   const TearGrowthSettings& s = body.material().growth;
   const membrane::CrackTip& tip = tips_[i].crack;
   const Eigen::Vector3d at = mesh.rest.col(tip.vertex);
@@ -99,7 +107,7 @@ TipGrowth TearGrowth::judge(const SkinnedSoftBody& body, const std::vector<std::
   options.domain_radius = radius;
   options.inner_fraction = s.inner_fraction;
   const membrane::TipFracture f = membrane::energy_release(
-      mesh, body.material().skin, rest_frame_positions(body, at, radius), tip, options);
+      mesh, body.material().skin, rest_frame_positions(body, mesh, at, radius), tip, options);
   TipGrowth out;
   out.vertex = tip.vertex;
   out.energy_release_rate = f.energy_release_rate;
@@ -111,7 +119,7 @@ TipGrowth TearGrowth::judge(const SkinnedSoftBody& body, const std::vector<std::
 
 void TearGrowth::extend(SkinnedSoftBody& body, mesh::Tear& tear, std::size_t i, TipGrowth& judged) {
   Tip& tip = tips_[i];
-  const mesh::SkinnedMesh& mesh = body.mesh();
+  const mesh::SkinnedMesh& mesh = skin_mesh(body);
   const Eigen::Vector3d along = membrane::growth_direction(mesh, tip.crack, judged.kink);
   const membrane::CrackExtension ext = membrane::crack_extension(
       mesh, fixed_vertices(body), tip.crack.vertex, along, body.material().growth.snap_fraction);
@@ -124,7 +132,7 @@ void TearGrowth::extend(SkinnedSoftBody& body, mesh::Tear& tear, std::size_t i, 
   body.apply(ext.change);
   tear.adopt_growth(tip.crack.vertex, ext.duplicate, ext.new_tip);
   tear_points_ = tear.path_length();
-  const Eigen::Vector3d to = body.mesh().rest.col(ext.new_tip);
+  const Eigen::Vector3d to = skin_mesh(body).rest.col(ext.new_tip);
   judged.extended = (to - from).norm();
   tip.crack = {ext.new_tip, (to - from) / judged.extended};
   grown_ += judged.extended;

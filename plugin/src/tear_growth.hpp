@@ -4,11 +4,15 @@
 // public edits (apply), so Bullet mirrors every growth step as it mirrors any change.
 #pragma once
 
+#include <Eigen/Core>
 #include <cstdint>
+#include <functional>
+#include <utility>
 #include <vector>
 
 #include "conform/bullet/tear_growth.hpp"
 #include "conform/membrane/energy_release.hpp"
+#include "conform/mesh/skinned_mesh.hpp"
 
 namespace conform::mesh {
 class Tear;
@@ -20,6 +24,16 @@ class SkinnedSoftBody;
 
 class TearGrowth {
  public:
+  /// The skin's rest state per vertex, read at each use (the bind pose: it grows with the mesh).
+  using RestSource = std::function<Eigen::Ref<const Eigen::Matrix3Xd>()>;
+  explicit TearGrowth(RestSource skin_rest) : skin_rest_(std::move(skin_rest)) {}
+  /// Forgets the tips and the length grown (a new tear).
+  void reset() {
+    tips_.clear();
+    tear_ = nullptr;
+    tear_points_ = -1;
+    grown_ = 0;
+  }
   /// One growth step of `body`'s tear (SkinnedSoftBody::grow_tear); `tear` is that tear, which
   /// takes each grown segment (mesh::Tear::adopt_growth).
   TearGrowthReport grow(SkinnedSoftBody& body, mesh::Tear* tear);
@@ -34,9 +48,15 @@ class TearGrowth {
   // The tear's ends as tips, when the tear or its blade's steps changed since the last call.
   void follow_tear(const SkinnedSoftBody& body);
   TipGrowth judge(const SkinnedSoftBody& body, const std::vector<std::uint8_t>& fixed,
-                  std::size_t i) const;
+                  std::size_t i);
   void extend(SkinnedSoftBody& body, mesh::Tear& tear, std::size_t i, TipGrowth& judged);
 
+  // The body's mesh with the skin's rest state as its rest points: the body's own mesh when they
+  // are the same, else a copy refreshed on each use.
+  const mesh::SkinnedMesh& skin_mesh(const SkinnedSoftBody& body);
+
+  RestSource skin_rest_;
+  mesh::SkinnedMesh view_;
   std::vector<Tip> tips_;
   const mesh::Tear* tear_ = nullptr;
   std::int32_t tear_points_ = -1;  // the blade's path when the tips were taken

@@ -7,6 +7,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "conform/membrane/crack_extension.hpp"
 #include "phase_clock.hpp"
 #include "piece_books.hpp"
 
@@ -26,7 +27,8 @@ void erase_value(std::vector<std::int32_t>& list, std::int32_t value) {
 
 void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
   ++topology_version_;
-  membrane_.invalidate();  // rebuilt from the rest mesh at the next substep
+  membrane_.invalidate();  // rebuilt from the rest state at the next substep
+  if (bind_.cols() > 0) membrane::extend_columns(bind_, change);  // as mesh::apply's rest
   const double start = thread_seconds();
   const std::int32_t v0 = change.base_vertex_count;
   if (v0 != std::int32_t(piece_of_.size()) || change.base_face_count != std::int32_t(faces_.size()))
