@@ -9,6 +9,7 @@
 #include <string>
 
 #include "conform/skin/limb_axes.hpp"
+#include "material_fit.hpp"
 #include "phase_clock.hpp"
 #include "piece_books.hpp"
 
@@ -151,6 +152,7 @@ SkinnedSoftBody::Impl::Impl(const WorldLink& link, const mesh::SkinnedMesh& mesh
     kinematic_[static_cast<std::size_t>(v)] = is_kinematic_by_weight(v);
   drive_.start(mesh_);
   bind_ = drive_.bind_pose(mesh_);
+  warnings_ = material_fit_warnings(material, skin_rest(), mesh_.faces);
   build(mesh_);
 }
 
@@ -416,6 +418,9 @@ const skin::Skeleton& SkinnedSoftBody::skeleton() const {
 }
 const Material& SkinnedSoftBody::material() const {
   return impl_->material();
+}
+const std::vector<std::string>& SkinnedSoftBody::material_warnings() const {
+  return impl_->warnings_;
 }
 void SkinnedSoftBody::sync_mesh() {
   impl_->sync_mesh();

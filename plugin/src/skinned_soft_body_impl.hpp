@@ -238,7 +238,8 @@ struct SkinnedSoftBody::Impl {
   MembraneDrive membrane_;
   // The bind pose where the mesh's rest points are not it (SkinDrive::bind_pose), else empty.
   Eigen::Matrix3Xd bind_;
-  std::vector<void*> vertex_node_;  // per vertex: its btSoftBody::Node (null when detached)
+  std::vector<std::string> warnings_;  // material_fit.hpp, at construction
+  std::vector<void*> vertex_node_;     // per vertex: its btSoftBody::Node (null when detached)
   Eigen::Matrix3Xd target_matrix_, previous_matrix_;
   std::vector<btVector3> volume_gradient_;  // hold_released_volumes' ∂V/∂x_i, reused
 

@@ -1,5 +1,7 @@
 #include "kinds/run_output.hpp"
 
+#include "conform/bullet/skinned_soft_body.hpp"
+
 #include <unistd.h>
 
 #include <cmath>
@@ -279,6 +281,7 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   summary["render"] = render;
   if (vtk_) summary["vtk"] = vtk;
   summary["failures"] = failures_;
+  summary["warnings"] = warnings_;
   // Settings, timings and what the scene added: JSON would hold NaN or inf as null.
   require_finite(summary, "summary.json");
   const fs::path path = dir_ / "summary.json", tmp = dir_ / ".summary.json.tmp";
@@ -289,6 +292,15 @@ fs::path RunOutput::finish(const Json& settings, Json metrics, Json timings, int
   }
   fs::rename(tmp, path);
   return path;
+}
+
+void RunOutput::warn_material(const bullet::SkinnedSoftBody& body) {
+  for (const std::string& w : body.material_warnings()) warn(w);
+}
+
+void RunOutput::warn(const std::string& message) {
+  std::cerr << "warning: " << message << "\n";
+  warnings_.push_back(message);
 }
 
 }  // namespace conform::scenes

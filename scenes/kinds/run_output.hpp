@@ -128,6 +128,11 @@ class RunOutput {
   /// What finish() did not produce that the run promised (a plot gnuplot failed to draw, a
   /// render, picture or video): summary.json's "failures"; the run then exits 1.
   const std::vector<std::string>& failures() const { return failures_; }
+  /// A warning the run goes on with (a body's material_warnings): printed on stderr and kept in
+  /// summary.json's "warnings".
+  void warn(const std::string& message);
+  /// Each of the body's material_warnings.
+  void warn_material(const bullet::SkinnedSoftBody& body);
 
  private:
   /// Draws the plots (each series that is 0 throughout left out, a sentence in `notes`); their
@@ -150,7 +155,7 @@ class RunOutput {
   int frames_ = 0;
   double offer_ms_ = 0;  // in picture(): snapshots taken in the stepping loop
   std::unique_ptr<Progress> progress_;
-  std::vector<std::string> failures_;
+  std::vector<std::string> failures_, warnings_;
 };
 
 /// Reads the common keys (scene, seed, duration, physics, outputs) of a scene object.

@@ -178,6 +178,7 @@ class Character final : public Scene {
     const skin::Animation* animation = chosen_animation(model);
     SoftWorld w(c);
     bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(model, material_);
+    out.warn_material(body);
     // No loop: this animation's last key is not its first, and the wrap would be a jump.
     if (animation)
       body.play(*animation, skin::Blend::log, false);

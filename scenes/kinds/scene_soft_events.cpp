@@ -155,6 +155,7 @@ class ArmEventScene : public Scene {
     mesh::Arm arm = posed_arm(resolution_, motion_);
     SoftWorld w(c);
     bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(arm.mesh, arm.skeleton, material_);
+    out.warn_material(body);
     const skin::Pose rest = skin::Pose::rest(arm.skeleton);
     const ArmMotion motion = motion_;
     body.set_pose_source([motion, rest](double t, skin::Pose& p) { motion.pose(rest, t, p); });

@@ -124,6 +124,7 @@ class TearOpening final : public Scene {
     skin::Pose pose;
     TearRun r(posed_arm(pose), pose, c, material_,
               OpeningProfiles(compare_.points, compare_.snapshots, stroke_.at, c.steps, c.dt));
+    out.warn_material(r.body);
     r.body.set_pose_source(flexing_pose(pose));
     out.open_metrics({"t", "physics_tear_points", "geometric_tear_points", "physics_max_opening",
                       "geometric_max_opening", "physics_area", "geometric_area",

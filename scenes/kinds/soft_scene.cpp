@@ -134,6 +134,21 @@ bullet::Material read_material(Reader& root, const bullet::Material& d) {
   // m/s: a runaway stops the run (the library's default, no bound, is for worlds of any unit).
   m.max_speed = r.number("max_speed", std::isinf(d.max_speed) ? 100.0 : d.max_speed, 1e-6, 1e12);
   r.finish();
+  // The membrane ignores the link fields. The kind's own values for them (its links option)
+  // stay out of the body; a value the scene file changes reaches it, and the body names it in its
+  // material_warnings.
+  if (m.model == bullet::MaterialModel::membrane) {
+    const bullet::Material none;
+    const auto unless_changed = [](double& field, double kind, double library) {
+      if (field == kind) field = library;
+    };
+    unless_changed(m.link_stiffness, d.link_stiffness, none.link_stiffness);
+    unless_changed(m.damping, d.damping, none.damping);
+    unless_changed(m.pretension, d.pretension, none.pretension);
+    unless_changed(m.target_stiffness, d.target_stiffness, none.target_stiffness);
+    unless_changed(m.target_damping, d.target_damping, none.target_damping);
+    unless_changed(m.kinematic_weight, d.kinematic_weight, none.kinematic_weight);
+  }
   return m;
 }
 

@@ -43,6 +43,7 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "conform/bullet/non_finite_state.hpp"
@@ -268,6 +269,11 @@ class SkinnedSoftBody {
   const mesh::SkinnedMesh& mesh() const;
   const skin::Skeleton& skeleton() const;
   const Material& material() const;
+  /// What does not fit between the material and the mesh, found when the body was made, each
+  /// naming the field and the figure: bullet_links fields set away from their defaults while the
+  /// model is the membrane (ignored), and an attachment whose decay length sqrt(E'' t / k) is
+  /// below half the median edge (the skin's tension then acts element by element).
+  const std::vector<std::string>& material_warnings() const;
   void sync_mesh();
   std::int32_t vertex_count() const;
   /// Connected pieces of the mesh (bodies holding faces).
