@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "../tests/plugin_world.hpp"
+#include "../tests/plugin/plugin_world.hpp"
 #include "conform/bullet/plugin.hpp"
 #include "conform/membrane/solver.hpp"
 #include "conform/mesh/primitives.hpp"

@@ -15,7 +15,7 @@
 #include "conform/mesh/analysis.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "plugin_world.hpp"
-#include "sanitized.hpp"
+#include "support/sanitized.hpp"
 
 using namespace conform;
 using conform::test::SoftWorld;

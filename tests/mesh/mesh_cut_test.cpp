@@ -15,8 +15,8 @@
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/primitives.hpp"
 #include "conform/skin/procedural_arm.hpp"
-#include "sanitized.hpp"
 #include "skin_reference.hpp"
+#include "support/sanitized.hpp"
 
 using namespace conform;
 using namespace conform::mesh;
