@@ -20,8 +20,8 @@ using conform::test::SoftWorld;
 
 namespace {
 
-const mesh::Arm& the_arm() {
-  static const mesh::Arm arm = mesh::make_arm(1);
+const skin::Arm& the_arm() {
+  static const skin::Arm arm = skin::make_arm(1);
   return arm;
 }
 
@@ -298,7 +298,7 @@ struct TornArm {
 
   TornArm(int variant, int resolution, int threads, bool flexing = true)
       : membrane(variant != kLinks) {
-    const mesh::Arm arm = mesh::make_arm(resolution);
+    const skin::Arm arm = skin::make_arm(resolution);
     bullet::Material material;
     material.solver.threads = threads;
     if (variant == kMembranePrevious) {

@@ -102,10 +102,10 @@ bullet::Material arm_material() {
   return m;
 }
 
-mesh::Arm posed_arm(int resolution, const ArmMotion& motion) {
-  mesh::ArmOptions mo;
+skin::Arm posed_arm(int resolution, const ArmMotion& motion) {
+  skin::ArmOptions mo;
   mo.resolution = resolution;
-  mesh::Arm arm = mesh::make_arm(mo);
+  skin::Arm arm = skin::make_arm(mo);
   skin::Pose pose;
   motion.pose(skin::Pose::rest(arm.skeleton), 0, pose);
   skin::Skinner<double> skinner(arm.skeleton, arm.mesh.rest,
@@ -152,7 +152,7 @@ class ArmEventScene : public Scene {
 
   Json run(RunOutput& out) override {
     const CommonSettings& c = common_;
-    mesh::Arm arm = posed_arm(resolution_, motion_);
+    skin::Arm arm = posed_arm(resolution_, motion_);
     SoftWorld w(c);
     bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(arm.mesh, arm.skeleton, material_);
     const skin::Pose rest = skin::Pose::rest(arm.skeleton);
@@ -250,7 +250,7 @@ class ArmEventScene : public Scene {
 
   // The cut at time t, its plane given in the rest arm and moved with the forearm (bone 1);
   // `special` gets the hand piece's vertices (the piece of the finger tips), `others` the rest.
-  Json cut_at(bullet::SkinnedSoftBody& body, const mesh::Arm& arm, double t,
+  Json cut_at(bullet::SkinnedSoftBody& body, const skin::Arm& arm, double t,
               std::vector<std::int32_t>& special, std::vector<std::int32_t>& others) const {
     const std::int32_t fingertip = arm.mesh.vertex_count() - 1;  // the hand's pole
     const std::int32_t before = body.vertex_count();
@@ -278,7 +278,7 @@ class ArmEventScene : public Scene {
 
   // The drill at time t, given in the rest arm and moved with the upper arm (bone 0);
   // `special` gets the rim (vertices on the cylinder when drilled: new and snapped ones).
-  Json drill_at(bullet::SkinnedSoftBody& body, const mesh::Arm& arm, double t, int& holes,
+  Json drill_at(bullet::SkinnedSoftBody& body, const skin::Arm& arm, double t, int& holes,
                 std::vector<std::int32_t>& special, std::vector<std::int32_t>& others) const {
     const std::int32_t before = body.vertex_count();
     const mesh::DrillTool tool{carried(arm.skeleton, motion_, t, 0, tip_),

@@ -20,6 +20,7 @@
 
 using namespace conform;
 using namespace conform::mesh;
+using conform::skin::make_arm;
 using Plane = cga::Plane<double>;
 using conform::test::added_face_angles;
 using conform::test::AngleReport;

@@ -80,7 +80,7 @@ Landing land(double voxel, const bullet::ReleaseOptions& release, int frames,
   Landing out;
   {
     bullet::Plugin plugin(world.world);
-    const mesh::Arm arm = mesh::make_arm({.segments = 16, .rings = 40});
+    const skin::Arm arm = skin::make_arm({.segments = 16, .rings = 40});
     bullet::Material material{};
     material.margin = margin;
     auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, material);
