@@ -280,7 +280,8 @@ BENCHMARK(BM_OpeningTearStep)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 // The default material against two baselines in the same run: Bullet's pre-tensioned links
 // (the tear-opening scene's link settings, the default before the membrane) and the membrane
 // at its previous solver settings (1 Pa, block-Jacobi CG); and the membrane with its Newton
-// systems solved in place rather than packed (packed_systems off: the same results). The arm of `resolution` (1: 2.6k vertices, 2: 10k, 3: 23k).
+// systems solved in place rather than packed (packed_systems off: the same results). The arm of
+// `resolution` (1: 2.6k vertices, 2: 10k, 3: 23k).
 enum Variant { kLinks = 0, kMembrane = 1, kMembranePrevious = 2, kMembraneUnpacked = 3 };
 
 // The torn arm of tear-opening (its scene defaults: one 1/60 s substep a frame for the
