@@ -53,6 +53,7 @@
 using namespace conform::mesh;
 using conform::bench::speedup;
 using conform::bench::timed;
+using conform::skin::make_arm;
 using Plane = conform::cga::Plane<double>;
 
 namespace {

@@ -17,8 +17,8 @@
 namespace conform::bench {
 
 /// 0 → the default arm (5,120 faces); else an arm of about that many faces.
-inline mesh::ArmOptions arm_with_faces(int faces) {
-  mesh::ArmOptions o;
+inline skin::ArmOptions arm_with_faces(int faces) {
+  skin::ArmOptions o;
   if (faces > 0) {
     // #F = 2 · rings · segments with rings ≈ 2.5 segments, as in the default arm.
     o.segments = static_cast<int>(std::lround(std::sqrt(faces / 5.0)));

@@ -8,7 +8,7 @@
 #include <memory>
 #include <string>
 
-#include "../tests/plugin_world.hpp"
+#include "../tests/plugin/plugin_world.hpp"
 #include "conform/bullet/plugin.hpp"
 #include "conform/membrane/solver.hpp"
 #include "conform/mesh/primitives.hpp"
@@ -20,8 +20,8 @@ using conform::test::SoftWorld;
 
 namespace {
 
-const mesh::Arm& the_arm() {
-  static const mesh::Arm arm = mesh::make_arm(1);
+const skin::Arm& the_arm() {
+  static const skin::Arm arm = skin::make_arm(1);
   return arm;
 }
 
@@ -300,7 +300,7 @@ struct TornArm {
   /// toughness > 0: the tear grows by itself (Material::growth) at that G_c, J/m^2.
   TornArm(int variant, int resolution, int threads, bool flexing = true, double toughness = 0)
       : membrane(variant != kLinks) {
-    const mesh::Arm arm = mesh::make_arm(resolution);
+    const skin::Arm arm = skin::make_arm(resolution);
     bullet::Material material;
     material.solver.threads = threads;
     if (toughness > 0) {

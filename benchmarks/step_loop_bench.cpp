@@ -28,7 +28,7 @@ struct ArmWorld {
     soft.world.addRigidBody(&ground);
     plugin = std::make_unique<bullet::Plugin>(soft.world);
     if (with_arm) {
-      const mesh::Arm arm = mesh::make_arm(1);
+      const skin::Arm arm = skin::make_arm(1);
       plugin->add_skinned_body(arm.mesh, arm.skeleton, bullet::Material{});
     }
   }

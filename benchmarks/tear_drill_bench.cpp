@@ -43,6 +43,7 @@
 using namespace conform::mesh;
 using conform::bench::speedup;
 using conform::bench::timed;
+using conform::skin::make_arm;
 
 namespace {
 

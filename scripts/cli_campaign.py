@@ -31,7 +31,7 @@ After each run it checks, and counts as a defect:
 
 Deterministic for a given --seed (apart from signal timing). Exit status 0 when no defect was
 found, 1 otherwise. `scripts/cli_campaign.py --runs 3000` is the campaign of the closing note;
-tests/cli_campaign_test.sh runs a small budget in the suite.
+tests/cli/cli_campaign_test.sh runs a small budget in the suite.
 
 Usage: scripts/cli_campaign.py --conform build/scenes/conform [--runs 3000] [--seed 7]
                                [--jobs 2] [--limit 10] [--max-rss-mb 512] [--keep DIR]

@@ -35,8 +35,13 @@ extra_configuration() {
   log="$(mktemp)"
   cmake -S "$root" -B "$dir" "${generator[@]}" -DCONFORM_BUILD_BENCHMARKS=OFF \
     -DCONFORM_WERROR="${stage_werror:-$werror}" "$@" >"$log" 2>&1 || { cat "$log"; return 1; }
-  local targets
-  mapfile -t targets < <(cd "$root/tests" && ls $pattern 2>/dev/null | sed 's/\.cpp$//')
+  # The targets: the test sources matching $pattern (file names, not paths), in tests/ or in
+  # one of its folders (tests/cga/, tests/plugin/, ...; fuzz/ holds no *_test.cpp).
+  local targets patterns p names=()
+  read -ra patterns <<<"$pattern"  # no globbing here: find matches the names
+  for p in "${patterns[@]}"; do names+=(-o -name "$p"); done
+  mapfile -t targets < <(find "$root/tests" -maxdepth 2 -type f \( "${names[@]:1}" \) -printf '%f\n' |
+    sed 's/\.cpp$//' | sort)
   cmake --build "$dir" --parallel "$jobs" --target conform "${targets[@]}" "${extra_targets[@]}"
   ctest --test-dir "$dir" --output-on-failure --parallel "$jobs" --timeout 900 \
     -R "$regex" -E NOT_BUILT

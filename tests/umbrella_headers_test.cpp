@@ -33,7 +33,7 @@ TEST(UmbrellaHeaders, EachLibraryHeaderBringsWhatAnApplicationUses) {
   static_assert(std::is_class_v<cga::Motor<double>>);
   // Calls through them: the procedural arm is built, and the IK's solution reaches its target
   // by forward kinematics.
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   EXPECT_GT(arm.mesh.vertex_count(), 0);
   EXPECT_EQ(arm.skeleton.joint_count(), 3);
   const ik::Arm<double> limb;

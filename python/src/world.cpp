@@ -51,9 +51,9 @@ void step(World& w, double dt, int substeps) {
 
 Body add_arm(const py::object& self, const bullet::Material& material, int resolution, int segments,
              int rings) {
-  mesh::ArmOptions o;
+  skin::ArmOptions o;
   o.resolution = resolution, o.segments = segments, o.rings = rings;
-  const mesh::Arm arm = mesh::make_arm(o);
+  const skin::Arm arm = skin::make_arm(o);
   World& w = self.cast<World&>();
   return make_body(self, w.plugin->add_skinned_body(arm.mesh, arm.skeleton, material));
 }

@@ -37,7 +37,8 @@ SeverSettings read_sever(Reader& cut, const SeverSettings& defaults);
 
 /// A static box whose top is at `height`, `size` (m, the model's scale) wide on each side of
 /// `centre` and 2 size thick. It sets the soft bodies' contact grid (Bullet's sparse SDF) to size /
-/// 100: at Bullet's 0.25 m a 5 cm piece sinks into a box (tests/plugin_release_test.cpp).
+/// 100: at Bullet's 0.25 m a 5 cm piece sinks into a box
+/// (tests/plugin/plugin_release_test.cpp).
 class Ground {
  public:
   static constexpr int kGroup = 1 << 6;  // broadphase group: meets only released pieces

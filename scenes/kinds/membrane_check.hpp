@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include "conform/membrane/skin_material.hpp"
@@ -13,6 +14,18 @@
 #include "kinds/run_output.hpp"
 
 namespace conform::scenes {
+
+/// Blocks of the built-in scenes' text (join_scene_json, kinds/scene.hpp) that the checks share,
+/// each default written once. The pinned sheet's skin of membrane-slit and membrane-hole: human
+/// skin's modulus and thickness, an equibiaxial pre-stress, no foundation.
+inline constexpr std::string_view kPinnedSheetMaterialJson = R"json(
+  "material": { "prestress": [400, 400], "prestress_axis": [1, 0, 0], "youngs_modulus": 420000, "poisson_ratio": 0.48,
+                "thickness": 0.0015, "attachment_stiffness": 0,
+                "attachment_normal_stiffness": 0, "wrinkling": false, "relative_tolerance": 0.0001, "max_cg_iterations": 4000 },)json";
+/// The step of membrane-slit, membrane-hole and membrane-edge: 1/60 s, one substep, no gravity
+/// (the sheet settles under its pre-stress alone).
+inline constexpr std::string_view kSheetCheckPhysicsJson = R"json(
+  "physics": { "dt": 0.016666666666666666, "substeps": 1, "gravity": [0, 0, 0] },)json";
 
 /// One root joint and one bone, both identity: a flat sheet's targets are its rest positions.
 /// The "sheet" object of the slit scenes (membrane-slit, membrane-griffith): width, resolution

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <initializer_list>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -44,6 +45,15 @@ struct SceneKind {
   /// "metrics", nested keys dotted (e.g. "physics.max_opening").
   const char* headline = "";
 };
+
+/// A built-in scene's text put together from blocks, so that a block several scenes share (the
+/// arm of cut and drill, the pinned sheet of membrane-slit and membrane-hole) is written once:
+/// the blocks joined as they are, so the text is the one a single literal would give.
+inline std::string join_scene_json(std::initializer_list<std::string_view> blocks) {
+  std::string text;
+  for (const std::string_view block : blocks) text += block;
+  return text;
+}
 
 /// Registers a scene kind during static initialisation. In the scene's file:
 ///   const SceneRegistration kRegistration{{"name", "summary", kJson, &make, rank}};

@@ -324,14 +324,14 @@ class SkinFollower {
   }
 
  private:
-  static mesh::Arm make_arm(int resolution) {
-    mesh::ArmOptions mo;
+  static skin::Arm make_arm(int resolution) {
+    skin::ArmOptions mo;
     mo.resolution = resolution;
-    return mesh::make_arm(mo);
+    return skin::make_arm(mo);
   }
 
   const ArmTrackSettings& s_;
-  mesh::Arm arm_;
+  skin::Arm arm_;
   skin::Skinner<double> skinner_;
   skin::Pose pose_;
   std::vector<std::pair<std::int32_t, int>> rigid_;

@@ -34,7 +34,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // The built-in scene `membrane-edge` (`conform scenes --show membrane-edge`).
-constexpr const char* kMembraneEdgeJson = R"json({
+const std::string kMembraneEdgeJson = join_scene_json({R"json({
   "scene": "membrane-edge",
   "description": "A square sheet of skin membrane (SI units) on its foundation (attachment_stiffness k), border free, pre-stressed by material.prestress = [sigma_xx, sigma_yy] along its axes, is cut along the plane x = 0 by the plugin's planar cut on the live Bullet soft body; it settles, and each lip's retraction at mid-edge is compared with the membrane on an elastic foundation (plane stress): u(d) = u0 exp(-d / l), u0 = sigma_xx l / E'', l = sqrt(E'' t / k), E'' = E / (1 - nu^2) (4 E / 3 for the incompressible neo-Hookean law: the law's modulus of a strain across the edge with none along it).",
   "duration": 0.5,
@@ -43,10 +43,10 @@ constexpr const char* kMembraneEdgeJson = R"json({
   "measure": { "fit_floor": 0.05 },
   "material": { "prestress": [400, 400], "prestress_axis": [1, 0, 0], "youngs_modulus": 420000, "poisson_ratio": 0.48,
                 "thickness": 0.0015, "attachment_stiffness": 400000,
-                "attachment_normal_stiffness": 40000000, "wrinkling": false, "relative_tolerance": 1e-06, "max_cg_iterations": 4000 },
-  "physics": { "dt": 0.016666666666666666, "substeps": 1, "gravity": [0, 0, 0] },
+                "attachment_normal_stiffness": 40000000, "wrinkling": false, "relative_tolerance": 1e-06, "max_cg_iterations": 4000 },)json",
+                                                       kSheetCheckPhysicsJson, R"json(
   "outputs": { "metrics_every": 1, "frames_every": 0, "plots": true }
-})json";
+})json"});
 
 // The retraction along the mid-edge row: per lip, distances from the edge (rest |x|) and
 // displacements away from the cut since just before it, nearest the edge first.
@@ -304,7 +304,7 @@ const SceneRegistration kMembraneEdgeRegistration{
     {"membrane-edge",
      "the cut against the foundation: a pre-stressed sheet on its foundation cut along x = 0 "
      "retracts by sigma l / E'' at the edge, decaying as exp(-d / l), l = sqrt(E'' t / k)",
-     kMembraneEdgeJson, &make_membrane_edge, 8,
+     kMembraneEdgeJson.c_str(), &make_membrane_edge, 8,
      "retraction_over_foundation,decay_length_over_foundation"}};
 
 }  // namespace

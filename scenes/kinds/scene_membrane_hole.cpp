@@ -26,18 +26,16 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // The built-in scene `membrane-hole` (`conform scenes --show membrane-hole`).
-constexpr const char* kMembraneHoleJson = R"json({
+const std::string kMembraneHoleJson =
+    join_scene_json({R"json({
   "scene": "membrane-hole",
   "description": "A square sheet of skin membrane (SI units) pinned at its border 30 hole radii away and pre-stressed by material.prestress = [sigma_xx, sigma_yy] along its axes is drilled through its centre by the project's drill on the live Bullet soft body; it settles, and the growth of the hole's semi-axes is compared with Kirsch's solution (plane stress): da_x / a = (2 sigma_xx - (1 - nu) sigma_yy) / E.",
   "duration": 1.0,
   "sheet": { "radii": 30, "resolution": 0.00125 },
-  "hole": { "radius": 0.01, "at": 0.1 },
-  "material": { "prestress": [400, 400], "prestress_axis": [1, 0, 0], "youngs_modulus": 420000, "poisson_ratio": 0.48,
-                "thickness": 0.0015, "attachment_stiffness": 0,
-                "attachment_normal_stiffness": 0, "wrinkling": false, "relative_tolerance": 0.0001, "max_cg_iterations": 4000 },
-  "physics": { "dt": 0.016666666666666666, "substeps": 1, "gravity": [0, 0, 0] },
+  "hole": { "radius": 0.01, "at": 0.1 },)json",
+                     kPinnedSheetMaterialJson, kSheetCheckPhysicsJson, R"json(
   "outputs": { "metrics_every": 1, "frames_every": 0, "plots": false }
-})json";
+})json"});
 
 struct RimFit {
   double growth_x = 0, growth_y = 0;  // relative change of the semi-axes
@@ -198,7 +196,8 @@ const SceneRegistration kMembraneHoleRegistration{
     {"membrane-hole",
      "the drill against Kirsch: a hole drilled in a pinned, pre-stressed sheet grows its "
      "semi-axes by (2 sigma_xx - (1 - nu) sigma_yy) / E and the same swapped",
-     kMembraneHoleJson, &make_membrane_hole, 7, "growth_x_over_kirsch,growth_y_over_kirsch"}};
+     kMembraneHoleJson.c_str(), &make_membrane_hole, 7,
+     "growth_x_over_kirsch,growth_y_over_kirsch"}};
 
 }  // namespace
 

@@ -32,18 +32,16 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 // The built-in scene `membrane-slit` (`conform scenes --show membrane-slit`).
-constexpr const char* kMembraneSlitJson = R"json({
+const std::string kMembraneSlitJson =
+    join_scene_json({R"json({
   "scene": "membrane-slit",
   "description": "A square sheet of skin membrane (SI units) pinned at its border and pre-stressed by material.prestress = [sigma_xx, sigma_yy] along its axes is slit through its centre by a topology change on the live Bullet soft body; it settles, and its opening is compared with linear elastic fracture mechanics (plane stress): w_max = 4 sigma_n a / E (4 sigma_n a H with the fibre-reinforced law, the slit along or across its fibres).",
   "duration": 1.0,
   "sheet": { "width": 1.2, "resolution": 0.0025, "tip_refinement": 16 },
-  "slit": { "length": 0.05, "angle_deg": 0, "at": 0.1 },
-  "material": { "prestress": [400, 400], "prestress_axis": [1, 0, 0], "youngs_modulus": 420000, "poisson_ratio": 0.48,
-                "thickness": 0.0015, "attachment_stiffness": 0,
-                "attachment_normal_stiffness": 0, "wrinkling": false, "relative_tolerance": 0.0001, "max_cg_iterations": 4000 },
-  "physics": { "dt": 0.016666666666666666, "substeps": 1, "gravity": [0, 0, 0] },
+  "slit": { "length": 0.05, "angle_deg": 0, "at": 0.1 },)json",
+                     kPinnedSheetMaterialJson, kSheetCheckPhysicsJson, R"json(
   "outputs": { "metrics_every": 1, "frames_every": 0, "plots": true }
-})json";
+})json"});
 
 class MembraneSlit final : public Scene {
  public:
@@ -206,7 +204,7 @@ const SceneRegistration kMembraneSlitRegistration{
     {"membrane-slit",
      "the skin membrane against LEFM: a pinned, pre-stressed sheet slit through its centre "
      "opens as an ellipse of maximum 4 sigma_n a / E",
-     kMembraneSlitJson, &make_membrane_slit, 5, "w_max_over_lefm,w_max"}};
+     kMembraneSlitJson.c_str(), &make_membrane_slit, 5, "w_max_over_lefm,w_max"}};
 
 }  // namespace
 

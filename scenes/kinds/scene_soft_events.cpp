@@ -10,6 +10,8 @@
 #include <cmath>
 #include <numbers>
 #include <optional>
+#include <string>
+#include <string_view>
 
 #include "conform/mesh/analysis.hpp"
 #include "conform/skin/procedural_arm.hpp"
@@ -22,39 +24,37 @@
 namespace conform::scenes {
 namespace {
 
-// The built-in scene `cut`, the defaults of this kind (`conform scenes --show cut`).
-constexpr const char* kCutJson = R"json({
-  "scene": "cut",
-  "description": "The moving procedural arm as a CGA-skinned Bullet soft body (every node pulled toward its skinned target) is cut through the forearm by a plane; both pieces keep simulating under gravity and the hand piece keeps following the wrist and hand bones. With cut.release the hand piece is released from skinning instead and falls (a capped piece, cut.cap, keeps its volume with the bulk modulus cut.volume_modulus, Pa) onto the ground (ground.enabled, its top at ground.height, m), which only released pieces meet.",
+// What cut and drill share, each default written once: the seed and duration, the arm (its
+// resolution, motion and material), then, closing the file, the step and the outputs.
+constexpr std::string_view kArmJson = R"json(
   "seed": 1,
   "duration": 3.0,
   "model": { "resolution": 1 },
   "pose": { "shoulder_swing_deg": 20, "elbow_deg": 10, "elbow_swing_deg": 40, "period": 2 },
   "material": { "target_stiffness": 4000, "target_damping": 40, "kinematic_weight": 2,
-                "damping": 0.02 },
+                "damping": 0.02 },)json";
+constexpr std::string_view kArmRunJson = R"json(
+  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
+               "gravity": [0, -9.81, 0] },
+  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
+})json";
+// The built-in scene `cut`, the defaults of this kind (`conform scenes --show cut`).
+const std::string kCutJson = join_scene_json({R"json({
+  "scene": "cut",
+  "description": "The moving procedural arm as a CGA-skinned Bullet soft body (every node pulled toward its skinned target) is cut through the forearm by a plane; both pieces keep simulating under gravity and the hand piece keeps following the wrist and hand bones. With cut.release the hand piece is released from skinning instead and falls (a capped piece, cut.cap, keeps its volume with the bulk modulus cut.volume_modulus, Pa) onto the ground (ground.enabled, its top at ground.height, m), which only released pieces meet.",)json",
+                                              kArmJson, R"json(
   "cut": { "at": 0.5, "point": [0, 0, 0.4234], "normal": [0, 0.05, 1], "cap": false,
            "release": false, "volume_modulus": 100000 },
-  "ground": { "enabled": false, "height": -0.5 },
-  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
-               "gravity": [0, -9.81, 0] },
-  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
-})json";
+  "ground": { "enabled": false, "height": -0.5 },)json",
+                                              kArmRunJson});
 // The built-in scene `drill`, the defaults of this kind (`conform scenes --show drill`).
-constexpr const char* kDrillJson = R"json({
+const std::string kDrillJson = join_scene_json({R"json({
   "scene": "drill",
-  "description": "A cylindrical drill (radius 12 mm) goes through both walls of the upper arm of the CGA-skinned soft arm; the arm then swings and flexes, and the rim nodes are measured against their skinned targets.",
-  "seed": 1,
-  "duration": 3.0,
-  "model": { "resolution": 1 },
-  "pose": { "shoulder_swing_deg": 20, "elbow_deg": 10, "elbow_swing_deg": 40, "period": 2 },
-  "material": { "target_stiffness": 4000, "target_damping": 40, "kinematic_weight": 2,
-                "damping": 0.02 },
+  "description": "A cylindrical drill (radius 12 mm) goes through both walls of the upper arm of the CGA-skinned soft arm; the arm then swings and flexes, and the rim nodes are measured against their skinned targets.",)json",
+                                                kArmJson, R"json(
   "drill": { "at": 0.5, "tip": [0.1, 0.0031, 0.1512], "base": [-0.1, 0.0031, 0.1512],
-             "radius": 0.012 },
-  "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
-               "gravity": [0, -9.81, 0] },
-  "outputs": { "metrics_every": 1, "frames_every": 30, "plots": true }
-})json";
+             "radius": 0.012 },)json",
+                                                kArmRunJson});
 using Clock = std::chrono::steady_clock;
 using Vec3 = Eigen::Vector3d;
 constexpr double kPi = std::numbers::pi;
@@ -102,10 +102,10 @@ bullet::Material arm_material() {
   return m;
 }
 
-mesh::Arm posed_arm(int resolution, const ArmMotion& motion) {
-  mesh::ArmOptions mo;
+skin::Arm posed_arm(int resolution, const ArmMotion& motion) {
+  skin::ArmOptions mo;
   mo.resolution = resolution;
-  mesh::Arm arm = mesh::make_arm(mo);
+  skin::Arm arm = skin::make_arm(mo);
   skin::Pose pose;
   motion.pose(skin::Pose::rest(arm.skeleton), 0, pose);
   skin::Skinner<double> skinner(arm.skeleton, arm.mesh.rest,
@@ -152,7 +152,7 @@ class ArmEventScene : public Scene {
 
   Json run(RunOutput& out) override {
     const CommonSettings& c = common_;
-    mesh::Arm arm = posed_arm(resolution_, motion_);
+    skin::Arm arm = posed_arm(resolution_, motion_);
     SoftWorld w(c);
     bullet::SkinnedSoftBody& body = w.plugin->add_skinned_body(arm.mesh, arm.skeleton, material_);
     out.warn_material(body);
@@ -251,7 +251,7 @@ class ArmEventScene : public Scene {
 
   // The cut at time t, its plane given in the rest arm and moved with the forearm (bone 1);
   // `special` gets the hand piece's vertices (the piece of the finger tips), `others` the rest.
-  Json cut_at(bullet::SkinnedSoftBody& body, const mesh::Arm& arm, double t,
+  Json cut_at(bullet::SkinnedSoftBody& body, const skin::Arm& arm, double t,
               std::vector<std::int32_t>& special, std::vector<std::int32_t>& others) const {
     const std::int32_t fingertip = arm.mesh.vertex_count() - 1;  // the hand's pole
     const std::int32_t before = body.vertex_count();
@@ -279,7 +279,7 @@ class ArmEventScene : public Scene {
 
   // The drill at time t, given in the rest arm and moved with the upper arm (bone 0);
   // `special` gets the rim (vertices on the cylinder when drilled: new and snapped ones).
-  Json drill_at(bullet::SkinnedSoftBody& body, const mesh::Arm& arm, double t, int& holes,
+  Json drill_at(bullet::SkinnedSoftBody& body, const skin::Arm& arm, double t, int& holes,
                 std::vector<std::int32_t>& special, std::vector<std::int32_t>& others) const {
     const std::int32_t before = body.vertex_count();
     const mesh::DrillTool tool{carried(arm.skeleton, motion_, t, 0, tip_),
@@ -356,10 +356,10 @@ const SceneRegistration kCutRegistration{
     {"cut",
      "a planar cut through the forearm of the moving soft arm; the pieces keep simulating under "
      "gravity, the hand piece stays skinned to its bones",
-     kCutJson, &make_cut, 2, "offset_max,offset_mean"}};
+     kCutJson.c_str(), &make_cut, 2, "offset_max,offset_mean"}};
 const SceneRegistration kDrillRegistration{
     {"drill",
      "a hole drilled through the upper arm, then the arm moves; the hole's rim stays on the skin",
-     kDrillJson, &make_drill, 3, "offset_max,offset_mean"}};
+     kDrillJson.c_str(), &make_drill, 3, "offset_max,offset_mean"}};
 }  // namespace
 }  // namespace conform::scenes

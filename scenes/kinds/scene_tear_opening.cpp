@@ -177,7 +177,7 @@ class TearOpening final : public Scene {
   // Everything one run keeps: the same posed arm torn twice, as a mesh alone (geometric) and
   // as a soft body (physics), and what is measured along the way.
   struct TearRun {
-    mesh::Arm arm;
+    skin::Arm arm;
     GeometricTear geo;  // the geometric run: the mesh alone
     SoftWorld world;    // the physics run
     double build_ms = 0;
@@ -195,7 +195,7 @@ class TearOpening final : public Scene {
     double worst_residual = 0, before_flex = -1;  // the membrane's solves; the opening then
     int unconverged = 0;
 
-    TearRun(mesh::Arm posed, const skin::Pose& pose, const CommonSettings& c,
+    TearRun(skin::Arm posed, const skin::Pose& pose, const CommonSettings& c,
             const bullet::Material& material, OpeningProfiles kept)
         : arm(std::move(posed)),
           geo(arm.mesh, lips()),
@@ -211,7 +211,7 @@ class TearOpening final : public Scene {
       o.smooth_lips = true;
       return o;
     }
-    static bullet::SkinnedSoftBody& add_body(SoftWorld& w, const mesh::Arm& arm,
+    static bullet::SkinnedSoftBody& add_body(SoftWorld& w, const skin::Arm& arm,
                                              const bullet::Material& material, double& ms) {
       bullet::SkinnedSoftBody* body = nullptr;
       ms = milliseconds(
@@ -228,10 +228,10 @@ class TearOpening final : public Scene {
   }
 
   // The arm with its elbow flexed; both runs start from this posed (skinned) arm.
-  mesh::Arm posed_arm(skin::Pose& pose) const {
-    mesh::ArmOptions mo;
+  skin::Arm posed_arm(skin::Pose& pose) const {
+    skin::ArmOptions mo;
     mo.resolution = resolution_;
-    mesh::Arm arm = mesh::make_arm(mo);
+    skin::Arm arm = skin::make_arm(mo);
     pose = skin::Pose::rest(arm.skeleton);
     pose.set_local(
         1,
@@ -247,7 +247,7 @@ class TearOpening final : public Scene {
 
   // The posed arm, its elbow flexing by flex_deg over flex_duration from flex_at (smoothstep).
   std::function<void(double, skin::Pose&)> flexing_pose(const skin::Pose& start) const {
-    const double upper_arm = mesh::ArmOptions{}.upper_arm;
+    const double upper_arm = skin::ArmOptions{}.upper_arm;
     return [=, this](double time, skin::Pose& out) {
       out = start;
       const double u = std::clamp((time - flex_at_) / flex_duration_, 0.0, 1.0);

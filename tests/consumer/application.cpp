@@ -295,7 +295,7 @@ void run(const std::string& model_file, bool world_first) {
   character.snap_to_pose();
 
   // The procedural arm tracking a moving target with the IK, colliding with nothing.
-  const conform::mesh::Arm small = conform::mesh::make_arm({.segments = 16, .rings = 40});
+  const conform::skin::Arm small = conform::skin::make_arm({.segments = 16, .rings = 40});
   auto& ik_arm = plugin->add_skinned_body(small.mesh, small.skeleton, links, {.collision_mask = 0});
   ik_arm.set_world_transform(Eigen::Isometry3d(Eigen::Translation3d(2, 0, 0)));
   ik_arm.set_pose_source(

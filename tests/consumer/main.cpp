@@ -26,7 +26,7 @@ int main() {
 
   // Conform attaches through addAction; the arm is skinned by CGA motors every substep.
   conform::bullet::Plugin plugin(world);
-  const conform::mesh::Arm arm = conform::mesh::make_arm(1);  // 2562 vertices, 3 bones
+  const conform::skin::Arm arm = conform::skin::make_arm(1);  // 2562 vertices, 3 bones
   conform::bullet::Material material;
   material.skin.prestress = {80.8e3, 80.8e3};  // Pa: wounds open by themselves
   auto& skin = plugin.add_skinned_body(arm.mesh, arm.skeleton, material);

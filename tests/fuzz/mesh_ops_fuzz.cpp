@@ -51,12 +51,12 @@ const SkinnedMesh& base_mesh(Bytes& in) {
   if (auto it = cache.find(key); it != cache.end()) return it->second;
   SkinnedMesh m;
   if (kind == 0) {
-    mesh::ArmOptions o;
+    skin::ArmOptions o;
     o.segments = (key - 1000) / 32;
     o.rings = (key - 1000) % 32;
-    m = mesh::make_arm(o).mesh;
+    m = skin::make_arm(o).mesh;
   } else if (kind == 1) {
-    m = mesh::make_arm(1).mesh;
+    m = skin::make_arm(1).mesh;
   } else if (kind == 2) {
     m = mesh::make_sheet(6, 5, 0.2, 0.15);
   } else {

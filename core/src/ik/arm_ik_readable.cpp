@@ -5,7 +5,7 @@
 // the closed form (kernel.hpp), which must give the same answer.
 //
 // Signs and formulas changed with respect to the paper's text (as extracted from the PDF),
-// each re-derived from the geometry and checked by forward kinematics (tests/ik_*_test.cpp):
+// each re-derived from the geometry and checked by forward kinematics (tests/ik/ik_*_test.cpp):
 //  1. Eq 11 (swivel plane) is right as printed once "φ2" is read as cos²(φ/2):
 //     n(φ) = cos φ (Pw × ẑ) + sin φ (Pw × (Pw × ẑ))/|Pw|, the plane through the z axis and
 //     Pw turned right-handedly by φ about L_sw. It is 0 on the z axis: there we use x̂ for ẑ.

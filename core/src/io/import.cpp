@@ -665,7 +665,7 @@ SkinnedModel import_model(const std::filesystem::path& path, const ImportOptions
 }
 
 SkinnedModel arm_model(int resolution) {
-  mesh::Arm arm = mesh::make_arm(resolution);
+  skin::Arm arm = skin::make_arm(resolution);
   SkinnedModel m;
   m.source = "arm:" + std::to_string(resolution);
   m.influences = skin::InfluenceLists::from_mesh(arm.mesh);
@@ -687,9 +687,9 @@ SkinnedModel load_model(const std::string& spec, const ImportOptions& options) {
     const char* b = spec.data() + 4;
     const char* e = spec.data() + spec.size();
     const auto r = std::from_chars(b, e, n);
-    if (r.ec != std::errc() || r.ptr != e || n < 1 || n > mesh::kMaxArmResolution)
+    if (r.ec != std::errc() || r.ptr != e || n < 1 || n > skin::kMaxArmResolution)
       throw ImportError(spec, "the arm's resolution must be an integer in [1, " +
-                                  std::to_string(mesh::kMaxArmResolution) + "]");
+                                  std::to_string(skin::kMaxArmResolution) + "]");
     return arm_model(n);
   }
   return import_model(spec, options);

@@ -7,8 +7,12 @@
 #include <string>
 #include <vector>
 
-namespace conform::mesh {
+namespace conform::skin {
 namespace {
+
+using mesh::Face;
+using mesh::kMaxInfluences;
+using mesh::SkinnedMesh;
 
 double smoothstep(double e0, double e1, double x) {
   const double u = std::clamp((x - e0) / (e1 - e0), 0.0, 1.0);
@@ -184,19 +188,19 @@ void arm_weights(const Profile& p, const ArmOptions& o, SkinnedMesh& m) {
 
 // Skeleton: joints at the shoulder (origin), elbow and wrist along +z; each bone's offset is
 // the inverse of its joint's bind placement (a translation by −z_joint).
-void arm_skeleton(const Profile& p, skin::Skeleton& sk) {
+void arm_skeleton(const Profile& p, Skeleton& sk) {
   const double joint_z[3] = {0, p.elbow, p.wrist};
   for (int j = 0; j < 3; ++j) {
-    skin::Joint joint;
+    Joint joint;
     joint.name = kArmJointNames[j];
     joint.parent = j - 1;
-    joint.rest = skin::Versor::from_motor(cga::Motor<double>::from_translation(
+    joint.rest = Versor::from_motor(cga::Motor<double>::from_translation(
         Eigen::Vector3d(0, 0, joint_z[j] - (j > 0 ? joint_z[j - 1] : 0.0))));
     sk.joints.push_back(joint);
-    skin::Bone bone;
+    Bone bone;
     bone.name = kArmJointNames[j];
     bone.joint = j;
-    bone.offset = skin::Versor::from_motor(
+    bone.offset = Versor::from_motor(
         cga::Motor<double>::from_translation(Eigen::Vector3d(0, 0, -joint_z[j])));
     sk.bones.push_back(bone);
   }
@@ -238,4 +242,4 @@ Arm make_arm(const ArmOptions& o) {
   return arm;
 }
 
-}  // namespace conform::mesh
+}  // namespace conform::skin

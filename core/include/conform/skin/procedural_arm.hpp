@@ -19,8 +19,8 @@
 // 1 elbow (forearm), 2 wrist (hand). Weights blend smoothly (smoothstep of z) across
 // ±4 cm of the elbow and ±3 cm of the wrist; elsewhere a vertex follows one bone.
 //
-// A rigged model (mesh + skeleton), so it sits in the skin layer, above mesh; its names stay in
-// conform::mesh, where every caller already finds them.
+// A rigged model (mesh + skeleton), so it sits in the skin layer, above mesh, and its names are
+// in conform::skin.
 #pragma once
 
 #include <cstdint>
@@ -28,7 +28,7 @@
 #include "conform/mesh/skinned_mesh.hpp"
 #include "conform/skin/skeleton.hpp"
 
-namespace conform::mesh {
+namespace conform::skin {
 
 struct ArmOptions {
   int resolution = 1;  // N: segments = 32 N around, rings = 80 N along
@@ -42,8 +42,8 @@ struct ArmOptions {
 };
 
 struct Arm {
-  SkinnedMesh mesh;         // rest == current, normals filled, uvs (around, along) in [0, 1]
-  skin::Skeleton skeleton;  // joints shoulder, elbow, wrist; bones 0, 1, 2 on them
+  mesh::SkinnedMesh mesh;  // rest == current, normals filled, uvs (around, along) in [0, 1]
+  Skeleton skeleton;       // joints shoulder, elbow, wrist; bones 0, 1, 2 on them
 };
 
 /// Joint names of the arm's skeleton, in order.
@@ -61,4 +61,4 @@ Arm make_arm(const ArmOptions& options = {});
 /// Shorthand for make_arm({.resolution = resolution}).
 Arm make_arm(int resolution);
 
-}  // namespace conform::mesh
+}  // namespace conform::skin

@@ -1,5 +1,5 @@
 // The previous closed form (kept as the in-run baseline of benchmarks/ik_bench.cpp and as a
-// cross-check in tests/ik_arm_test.cpp): the same elbow as kernel.hpp, but Qs built as the
+// cross-check in tests/ik/ik_arm_test.cpp): the same elbow as kernel.hpp, but Qs built as the
 // paper builds it, Qs = Q12 Q3 (eqs 15–18), with two dependent half-angle roots, and the
 // triangle factors f1…f4 from the root |Pw|. Internal; use conform/ik/arm_ik.hpp.
 #pragma once

@@ -3,7 +3,7 @@
 //
 //   btSoftRigidDynamicsWorld world(...);            // or btSoftMultiBodyDynamicsWorld
 //   conform::bullet::Plugin plugin(world);
-//   auto arm = conform::mesh::make_arm();
+//   auto arm = conform::skin::make_arm();
 //   auto& skin = plugin.add_skinned_body(arm.mesh, arm.skeleton, material);
 //   skin.set_keyframes(track);                       // or play(animation), set_pose_source(rig)
 //   world.stepSimulation(1.0 / 60);                  // skinning drives the soft body

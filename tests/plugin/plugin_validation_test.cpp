@@ -21,8 +21,8 @@ namespace {
 
 const cga::Plane<double> kCut = cga::Plane<double>::from_normal_point({0, 0, 1}, {0, 0, 0.42});
 
-mesh::Arm small_arm() {
-  return mesh::make_arm({.segments = 12, .rings = 24});
+skin::Arm small_arm() {
+  return skin::make_arm({.segments = 12, .rings = 24});
 }
 
 template <class F>
@@ -40,7 +40,7 @@ std::string message_of(F&& f) {
 TEST(PluginValidation, PlayRefusesAnAnimationOfAnotherSkeleton) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = small_arm();  // 3 joints
+  const skin::Arm arm = small_arm();  // 3 joints
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   skin::Animation animation;
   animation.name = "tail";
@@ -64,7 +64,7 @@ TEST(PluginValidation, PlayRefusesAnAnimationOfAnotherSkeleton) {
 TEST(PluginValidation, APoseSourceOfAnotherSkeletonIsRefusedNamingTheCounts) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = small_arm();
+  const skin::Arm arm = small_arm();
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   body.set_pose_source([](double, skin::Pose& pose) { pose.local.resize(7); });
   const std::string message = message_of([&] { world.step(1); });
@@ -74,7 +74,7 @@ TEST(PluginValidation, APoseSourceOfAnotherSkeletonIsRefusedNamingTheCounts) {
 TEST(PluginValidation, TargetsAndQueriesAreValidRightAfterAnEdit) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = small_arm();
+  const skin::Arm arm = small_arm();
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   const skin::Pose pose = test::bent_arm_pose(arm.skeleton, 0.3, 0.8);
   body.set_pose(pose);
@@ -110,7 +110,7 @@ TEST(PluginValidation, TargetsAndQueriesAreValidRightAfterAnEdit) {
 TEST(PluginValidation, AnEditInsideAStepHookIsRefusedSayingWhy) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = small_arm();
+  const skin::Arm arm = small_arm();
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   std::vector<std::string> messages;
   auto attempt = [&](const std::function<void()>& edit) { messages.push_back(message_of(edit)); };
@@ -139,7 +139,7 @@ TEST(PluginValidation, AnEditInsideAStepHookIsRefusedSayingWhy) {
 TEST(PluginValidation, EveryMaterialFieldIsRangeCheckedWithFieldValueAndRange) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = small_arm();
+  const skin::Arm arm = small_arm();
   struct Case {
     std::function<void(bullet::Material&)> set;
     std::string expected;
@@ -186,7 +186,7 @@ TEST(PluginValidation, EveryMaterialFieldIsRangeCheckedWithFieldValueAndRange) {
 TEST(PluginValidation, ReleaseOptionsAndStaleIdsAreRefusedWithTheirValues) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = small_arm();
+  const skin::Arm arm = small_arm();
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   const bullet::PieceId id = body.piece_ids().at(0);
   bullet::ReleaseOptions bad{};

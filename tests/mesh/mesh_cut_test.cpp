@@ -15,11 +15,12 @@
 #include "conform/mesh/cut.hpp"
 #include "conform/mesh/primitives.hpp"
 #include "conform/skin/procedural_arm.hpp"
-#include "sanitized.hpp"
 #include "skin_reference.hpp"
+#include "support/sanitized.hpp"
 
 using namespace conform;
 using namespace conform::mesh;
+using conform::skin::make_arm;
 using Plane = cga::Plane<double>;
 using conform::test::added_face_angles;
 using conform::test::AngleReport;

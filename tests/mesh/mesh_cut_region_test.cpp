@@ -22,6 +22,7 @@
 
 using namespace conform;
 using namespace conform::mesh;
+using conform::skin::make_arm;
 using Plane = cga::Plane<double>;
 
 namespace {

@@ -166,7 +166,7 @@ void expect_mirrors_mesh(const bullet::SkinnedSoftBody& body, const char* what) 
 struct LiveArm {
   SoftWorld w;
   bullet::Plugin plugin{w.world};
-  mesh::Arm arm = mesh::make_arm(1);
+  skin::Arm arm = skin::make_arm(1);
   bullet::SkinnedSoftBody* body = nullptr;
   skin::PoseTrack track;
   explicit LiveArm(double bending = 0) {
@@ -221,7 +221,7 @@ TEST(PluginTopology, RegionalCutSeversTheUpperArmOnlyKeepingMassAndMomentum) {
   // the cut to that loop: two pieces, not three, and no new node outside the sphere.
   SoftWorld w;
   bullet::Plugin plugin{w.world};
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   auto& body = plugin.add_skinned_body(
       arm.mesh, arm.skeleton, {.model = bullet::MaterialModel::bullet_links, .pretension = 0.1});
   skin::PoseTrack track;

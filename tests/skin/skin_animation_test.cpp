@@ -15,7 +15,7 @@ using skin::Pose;
 using skin::Versor;
 
 skin::Skeleton arm_skeleton() {
-  return mesh::make_arm().skeleton;
+  return skin::make_arm().skeleton;
 }
 
 // Between keys, the log blend of a pure rotation is slerp; the linear blend is nlerp (which
@@ -109,7 +109,7 @@ TEST(SkinAnimation, ValidateNamesTheProblem) {
 // Keyframes made on the fly: set the elbow's rotation and dilation in two keys, blend; the
 // skinned forearm follows the blended joint.
 TEST(SkinKeyframes, SetLocalAndBlend) {
-  const mesh::Arm arm = mesh::make_arm();
+  const skin::Arm arm = skin::make_arm();
   const auto& sk = arm.skeleton;
   Pose a = Pose::rest(sk), b = Pose::rest(sk);
   const Eigen::Vector3d elbow_t(0, 0, 0.30);

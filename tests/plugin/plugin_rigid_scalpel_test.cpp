@@ -35,7 +35,7 @@ struct Bench {
   std::unique_ptr<btRigidBody> blade;
   bool arm = false;
   explicit Bench(bool on_arm = false) : arm(on_arm) {
-    const mesh::Arm coarse = mesh::make_arm({.segments = 12, .rings = 20});
+    const skin::Arm coarse = skin::make_arm({.segments = 12, .rings = 20});
     body = on_arm ? &plugin.add_skinned_body(coarse.mesh, coarse.skeleton,
                                              {.model = bullet::MaterialModel::bullet_links})
                   : &plugin.add_skinned_body(

@@ -3,8 +3,8 @@
 // up to rounding), lands on a rigid box and stays outside it (no node more than 1 mm inside),
 // and with Bullet's volume constraint keeps its volume instead of crushing flat.
 //
-// Collision findings (measured here, see docs/library.md): Bullet's soft-rigid contacts (SDF_RS) sample
-// the rigid shape on a sparse signed-distance grid; at its default voxel size (0.25 m) the
+// Collision findings (measured here, see docs/library.md): Bullet's soft-rigid contacts (SDF_RS)
+// sample the rigid shape on a sparse signed-distance grid; at its default voxel size (0.25 m) the
 // grid is far coarser than a 5 cm piece, and the nodes sink into the box; at 0.025 m they do
 // not. A btStaticPlaneShape ground is not convex, the sparse SDF has no distance for it, and
 // pieces fall through it: use a thin box as ground.
@@ -80,7 +80,7 @@ Landing land(double voxel, const bullet::ReleaseOptions& release, int frames,
   Landing out;
   {
     bullet::Plugin plugin(world.world);
-    const mesh::Arm arm = mesh::make_arm({.segments = 16, .rings = 40});
+    const skin::Arm arm = skin::make_arm({.segments = 16, .rings = 40});
     bullet::Material material{};
     material.margin = margin;
     auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, material);

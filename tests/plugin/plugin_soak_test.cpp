@@ -47,7 +47,7 @@ struct Subject {
 };
 
 Subject arm_subject() {
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   Subject s{"arm", arm.mesh, arm.skeleton, {}, {}, mesh::bounding_diagonal(arm.mesh)};
   return s;  // the default material: the skin membrane
 }

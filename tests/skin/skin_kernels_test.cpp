@@ -46,7 +46,7 @@ double max_diff(const skin::SoaPoints<double>& a, const skin::SoaPoints<double>&
 }
 
 struct Fixture {
-  mesh::Arm arm = mesh::make_arm();
+  skin::Arm arm = skin::make_arm();
   skin::InfluenceLists lists = skin::InfluenceLists::from_mesh(arm.mesh);
 };
 
@@ -239,7 +239,7 @@ TEST(SkinVersor, NoCandyWrapper) {
 }
 
 TEST(SkinCga, ThreadCountDoesNotChangeResults) {
-  const mesh::Arm arm = mesh::make_arm(2);  // above the single-thread threshold
+  const skin::Arm arm = skin::make_arm(2);  // above the single-thread threshold
   const auto lists = skin::InfluenceLists::from_mesh(arm.mesh);
   skin::Skinner<double> one(arm.skeleton, arm.mesh.rest, lists),
       two(arm.skeleton, arm.mesh.rest, lists);

@@ -18,6 +18,7 @@
 
 using namespace conform;
 using namespace conform::mesh;
+using conform::skin::make_arm;
 
 namespace {
 

@@ -67,7 +67,7 @@ TEST(PluginSkinnedBody, ValidatesWorldAndInput) {
   btSequentialImpulseConstraintSolver solver;
   btDiscreteDynamicsWorld rigid(&dispatcher, &broadphase, &solver, &config);
   bullet::Plugin plain(rigid);
-  const auto arm = mesh::make_arm({.segments = 8, .rings = 10});
+  const auto arm = skin::make_arm({.segments = 8, .rings = 10});
   EXPECT_THROW(plain.add_skinned_body(arm.mesh, arm.skeleton), std::logic_error);
 
   SoftWorld w;
@@ -97,7 +97,7 @@ TEST(PluginSkinnedBody, ValidatesWorldAndInput) {
 TEST(PluginSkinnedBody, RefusesAFaceThatRepeatsAVertex) {
   SoftWorld w;
   bullet::Plugin plugin(w.world);
-  const auto arm = mesh::make_arm({.segments = 8, .rings = 10});
+  const auto arm = skin::make_arm({.segments = 8, .rings = 10});
   auto bad = arm.mesh;
   bad.faces[7][2] = bad.faces[7][0];
   try {
@@ -113,7 +113,7 @@ TEST(PluginSkinnedBody, RefusesAFaceThatRepeatsAVertex) {
 TEST(PluginSkinnedBody, BuildsNodesLinksFacesAndMasses) {
   SoftWorld w;
   bullet::Plugin plugin(w.world);
-  const auto arm = mesh::make_arm(1);
+  const auto arm = skin::make_arm(1);
   const bullet::Material material{.model = bullet::MaterialModel::bullet_links, .density = 1.3};
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, material);
   btSoftBody* sb = body.pieces().at(0);
@@ -141,7 +141,7 @@ TEST(PluginSkinnedBody, BuildsNodesLinksFacesAndMasses) {
 TEST(PluginSkinnedBody, KinematicNodesTrackTheirCgaSkinnedTargetsExactly) {
   SoftWorld w(9.81);
   bullet::Plugin plugin(w.world);
-  const auto arm = mesh::make_arm(1);
+  const auto arm = skin::make_arm(1);
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton,
                                        {.model = bullet::MaterialModel::bullet_links});
   const auto track = bending_track(arm.skeleton);
@@ -168,7 +168,7 @@ TEST(PluginSkinnedBody, KinematicNodesTrackTheirCgaSkinnedTargetsExactly) {
 TEST(PluginSkinnedBody, FreeNodesConvergeToTheirTargets) {
   SoftWorld w;
   bullet::Plugin plugin(w.world);
-  const auto arm = mesh::make_arm(1);
+  const auto arm = skin::make_arm(1);
   // Only the shoulder end is kinematic; everything else follows by the per-node pull.
   auto& body = plugin.add_skinned_body(
       arm.mesh, arm.skeleton,
@@ -207,7 +207,7 @@ TEST(PluginSkinnedBody, FreeNodesConvergeToTheirTargets) {
 TEST(PluginSkinnedBody, PretensionSurvivesBulletsRestLengthReset) {
   SoftWorld w;
   bullet::Plugin plugin(w.world);
-  const auto arm = mesh::make_arm({.segments = 16, .rings = 40});
+  const auto arm = skin::make_arm({.segments = 16, .rings = 40});
   const double s = 0.2;
   auto& body = plugin.add_skinned_body(
       arm.mesh, arm.skeleton, {.model = bullet::MaterialModel::bullet_links, .pretension = s});

@@ -1,7 +1,7 @@
 // The ParaView series (outputs.vtk, conform run --vtk; scenes/render/vtk_series.hpp) through
 // the `conform` command: its .pvd and .vtu files read back with meshio by
-// tests/vtk_series_check.py against the run's PLY frames, metrics.csv and summary.json; a
-// missing or failing meshio is said, and leaves no partial series; a bad key is refused.
+// tests/scenes/vtk_series_check.py against the run's PLY frames, metrics.csv and summary.json;
+// a missing or failing meshio is said, and leaves no partial series; a bad key is refused.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -26,10 +26,10 @@ bool have_meshio() {
   return std::system(cmd.c_str()) == 0;
 }
 
-// Runs tests/vtk_series_check.py on a run folder; its report goes to the test's output.
+// Runs tests/scenes/vtk_series_check.py on a run folder; its report goes to the test's output.
 int check_series(const fs::path& run, const std::string& options) {
   const std::string cmd = std::string(kPython) + " " + CONFORM_SOURCE_DIR +
-                          "/tests/vtk_series_check.py " + run.string() + " " + options;
+                          "/tests/scenes/vtk_series_check.py " + run.string() + " " + options;
   const int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }

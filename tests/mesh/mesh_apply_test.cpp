@@ -19,6 +19,8 @@
 
 using namespace conform;
 using namespace conform::mesh;
+using conform::skin::ArmOptions;
+using conform::skin::make_arm;
 
 namespace {
 

@@ -16,6 +16,7 @@
 #include "conform/skin/procedural_arm.hpp"
 
 using namespace conform::mesh;
+using conform::skin::make_arm;
 
 namespace {
 

@@ -9,8 +9,8 @@
 
 namespace {
 
-using conform::mesh::Arm;
-using conform::mesh::make_arm;
+using conform::skin::Arm;
+using conform::skin::make_arm;
 
 std::uint64_t key(std::int32_t a, std::int32_t b) {
   return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) |
@@ -185,7 +185,7 @@ TEST(ArmMesh, ResolutionScalesCounts) {
 }
 
 TEST(ArmMesh, ExplicitCountsAndBadOptions) {
-  conform::mesh::ArmOptions o;
+  conform::skin::ArmOptions o;
   o.segments = 7;
   o.rings = 3;
   const Arm arm = make_arm(o);

@@ -69,7 +69,7 @@ std::array<std::int32_t, 3> sorted(mesh::Face f) {
 TEST(PluginRender, FaceTagsFollowTheirFacesThroughSplitsAndEdits) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  const skin::Arm arm = skin::make_arm({.segments = 12, .rings = 24});
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   ASSERT_EQ(body.face_tags().size(), arm.mesh.faces.size());
   for (const auto& tag : body.face_tags()) EXPECT_EQ(tag, mesh::FaceTag{});
@@ -126,7 +126,7 @@ TEST(PluginRender, FaceTagsFollowTheirFacesThroughSplitsAndEdits) {
 TEST(PluginRender, CounterNormalsPoseAndDebugDraw) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  const skin::Arm arm = skin::make_arm({.segments = 12, .rings = 24});
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   EXPECT_EQ(body.topology_version(), 0u);
 
@@ -181,7 +181,7 @@ TEST(PluginRender, CounterNormalsPoseAndDebugDraw) {
 TEST(PluginRender, DebugDrawShowsTheTearPathAndTheBlade) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  const skin::Arm arm = skin::make_arm({.segments = 12, .rings = 24});
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   CountingDraw none;
   body.debug_draw(none);
@@ -215,7 +215,7 @@ TEST(PluginRender, DebugDrawShowsTheTearPathAndTheBlade) {
 TEST(PluginRender, ClockAndSnapToTheFirstPose) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  const skin::Arm arm = skin::make_arm({.segments = 12, .rings = 24});
   const skin::Pose bent = test::bent_arm_pose(arm.skeleton, 0.0, 1.2);
   auto max_speed = [](const bullet::SkinnedSoftBody& body) {
     double s = 0;
@@ -270,7 +270,7 @@ TEST(PluginRender, ClockAndSnapToTheFirstPose) {
 TEST(PluginRender, AWorldTransformPlacesTheSkinnedTargets) {
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+  const skin::Arm arm = skin::make_arm({.segments = 12, .rings = 24});
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   const skin::Pose pose = test::bent_arm_pose(arm.skeleton, 0.2, 0.9);
   body.set_pose(pose);

@@ -26,7 +26,7 @@ struct Scene {
   bullet::SkinnedSoftBody* body = nullptr;
   int destroyed = 0;  // body_destroyed events seen
   Scene() {
-    const mesh::Arm arm = mesh::make_arm({.segments = 12, .rings = 24});
+    const skin::Arm arm = skin::make_arm({.segments = 12, .rings = 24});
     body = &plugin->add_skinned_body(arm.mesh, arm.skeleton);
     body->on_piece_event([this](const bullet::PieceEvent& e) {
       destroyed += e.kind == bullet::PieceEvent::Kind::body_destroyed;

@@ -30,6 +30,7 @@
 namespace {
 
 using namespace conform::mesh;
+using conform::skin::make_arm;
 using Plane = conform::cga::Plane<double>;
 
 // FNV-1a over 64-bit words.

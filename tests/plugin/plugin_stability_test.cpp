@@ -15,7 +15,7 @@
 #include "conform/mesh/analysis.hpp"
 #include "conform/skin/procedural_arm.hpp"
 #include "plugin_world.hpp"
-#include "sanitized.hpp"
+#include "support/sanitized.hpp"
 
 using namespace conform;
 using conform::test::SoftWorld;
@@ -32,7 +32,7 @@ Eigen::Vector3d random_unit(std::mt19937& rng) {
 struct RunningArm {
   SoftWorld w;
   bullet::Plugin plugin{w.world};
-  mesh::Arm arm = mesh::make_arm(1);
+  skin::Arm arm = skin::make_arm(1);
   bullet::SkinnedSoftBody* body = nullptr;
   double size = 0, mass = 0;  // the model's bounding diagonal, the body's total mass
   std::mt19937 rng{20261122};

@@ -15,6 +15,8 @@
 #include "skin_reference.hpp"
 
 using namespace conform::mesh;
+using conform::skin::ArmOptions;
+using conform::skin::make_arm;
 
 namespace {
 

@@ -48,8 +48,8 @@ TEST(SceneFallingPieces, TheCharactersSeveredArmFallsOntoTheGroundAndRests) {
 }
 
 TEST(SceneFallingPieces, TheArmsReleasedHandLandsWhereTheGroundIsAndFallsOnWithoutIt) {
-  // 4 substeps: at the scene's 2 a dropped hand keeps 87-91 % of its volume (tests/plugin_release
-  // _test.cpp measures the step's part).
+  // 4 substeps: at the scene's 2 a dropped hand keeps 87-91 % of its volume
+  // (tests/plugin/plugin_release_test.cpp measures the step's part).
   const std::string release = kMargin +
                               "--set render=false --set cut.release=true --set cut.cap=true "
                               "--set physics.substeps=4 ";

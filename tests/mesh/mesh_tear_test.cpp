@@ -17,6 +17,7 @@
 
 using namespace conform;
 using namespace conform::mesh;
+using conform::skin::make_arm;
 using conform::test::added_face_angles;
 using conform::test::AngleReport;
 

@@ -121,7 +121,7 @@ TEST(PluginMembrane, NoPrestressNoOpening) {
 TEST(PluginMembrane, EditsOfAMovingArmConserveMassAndMomentum) {
   test::SoftWorld w(9.81);
   bullet::Plugin plugin(w.world);
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, bullet::Material{});
   skin::PoseTrack track;
   track.set_key(0, skin::Pose::rest(arm.skeleton));

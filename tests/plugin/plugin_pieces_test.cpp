@@ -25,8 +25,8 @@ namespace {
 
 const cga::Plane<double> kCut = cga::Plane<double>::from_normal_point({0, 0, 1}, {0, 0, 0.42});
 
-mesh::Arm small_arm() {
-  return mesh::make_arm({.segments = 12, .rings = 24});
+skin::Arm small_arm() {
+  return skin::make_arm({.segments = 12, .rings = 24});
 }
 
 // The two vertices of an edge used by one face only, in piece `p`, nearest to x = `at`.
@@ -52,7 +52,7 @@ TEST(PluginPieces, SplitAnnouncesTheNewPieceWithItsParent) {
   std::vector<PieceEvent> events;  // outlives the plugin: the listener runs in its destructor
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = small_arm();
+  const skin::Arm arm = small_arm();
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   const std::vector<PieceId> before = body.piece_ids();
   ASSERT_EQ(before.size(), 1u);
@@ -139,7 +139,7 @@ TEST(PluginPieces, SplitPiecesInheritUserCollisionFilterAndConfig) {
   PieceId child{};
   SoftWorld world;
   bullet::Plugin plugin(world.world);
-  const mesh::Arm arm = small_arm();
+  const skin::Arm arm = small_arm();
   // btSoftBody::Config leaves its fields uninitialized: a template starts from a body's.
   btSoftBody probe(&world.world.getWorldInfo(), 0, nullptr, nullptr);
   btSoftBody::Config config = probe.m_cfg;

@@ -35,7 +35,7 @@ Eigen::Vector3d uv_gradient(const mesh::SkinnedMesh& m, const mesh::Face& f, int
 }
 
 TEST(MembraneDirectionField, TheArmsBonesPointFromShoulderToWrist) {
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   const std::vector<Eigen::Vector3d> axes = skin::bone_axes(arm.skeleton);
   ASSERT_EQ(axes.size(), 3u);
   // The arm is built along +z (shoulder at the origin); the wrist's bone, without a child,
@@ -44,7 +44,7 @@ TEST(MembraneDirectionField, TheArmsBonesPointFromShoulderToWrist) {
 }
 
 TEST(MembraneDirectionField, AlongAndAroundFollowTheArmsSurfaceParametrisation) {
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   const mesh::SkinnedMesh& m = arm.mesh;
   const Eigen::Matrix3Xd limb = skin::vertex_limb_axes(m, skin::bone_axes(arm.skeleton));
   SkinMaterial along, around;
@@ -74,7 +74,7 @@ TEST(MembraneDirectionField, AlongAndAroundFollowTheArmsSurfaceParametrisation) 
 }
 
 TEST(MembraneDirectionField, TheBoneFieldsNeedTheLimbAxes) {
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   SkinMaterial m;
   m.prestress_field = Field::around_bones;
   m.prestress = {80e3, 40e3};

@@ -42,7 +42,7 @@ bullet::NonFiniteState step_until_thrown(SoftWorld& w, int steps) {
 struct TwoArms : ::testing::Test {
   SoftWorld w;
   bullet::Plugin plugin{w.world};
-  mesh::Arm arm = mesh::make_arm(1);
+  skin::Arm arm = skin::make_arm(1);
   bullet::SkinnedSoftBody* first = nullptr;
   bullet::SkinnedSoftBody* second = nullptr;
   void SetUp() override {
@@ -128,7 +128,7 @@ TEST(PluginNonFinite, ARunawayNodeStopsTheStepBeforeItOverflows) {
   // is no bound (it does not know the world's unit); this world is in metres.
   SoftWorld w;
   bullet::Plugin plugin{w.world};
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   bullet::Material links{.model = bullet::MaterialModel::bullet_links};
   EXPECT_TRUE(std::isinf(links.max_speed));
   links.max_speed = 100;
@@ -148,7 +148,7 @@ TEST(PluginNonFinite, ARunawayNodeStopsTheStepBeforeItOverflows) {
 TEST(PluginNonFinite, WithoutABoundAFastNodeGoesOnAndABadBoundIsRefused) {
   SoftWorld w;
   bullet::Plugin plugin{w.world};
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   bullet::Material links{.model = bullet::MaterialModel::bullet_links};
   bullet::SkinnedSoftBody& body = plugin.add_skinned_body(arm.mesh, arm.skeleton, links);
   w.step(1);
@@ -171,7 +171,7 @@ TEST_F(TwoArms, AfterTheThrowThePluginStillEditsAndTearsDown) {
 TEST(PluginNonFinite, TheMembraneDriveStopsOnANaNNode) {
   SoftWorld w;
   bullet::Plugin plugin{w.world};
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);  // the default membrane
   w.step(2);
   const std::int32_t v = arm.mesh.vertex_count() / 2;
@@ -193,7 +193,7 @@ TEST(PluginNonFinite, TheMembraneDriveStopsOnANaNNode) {
 TEST(PluginNonFinite, AHealthyRunNeverTripsTheCheck) {
   SoftWorld w(9.81);
   bullet::Plugin plugin{w.world};
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   auto& body = plugin.add_skinned_body(arm.mesh, arm.skeleton);
   body.set_pose(conform::test::bent_arm_pose(arm.skeleton, 0.4, 1.0));
   EXPECT_NO_THROW(w.step(30));
