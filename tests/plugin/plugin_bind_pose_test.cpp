@@ -38,7 +38,7 @@ void simulate(ArmRun& r, const mesh::SkinnedMesh& mesh, const skin::Skeleton& sk
 }
 
 TEST(PluginBindPose, MeshSpaceOfAnotherScaleSimulatesAsTheBindPose) {
-  const mesh::Arm arm = mesh::make_arm(1);
+  const skin::Arm arm = skin::make_arm(1);
   mesh::SkinnedMesh small = arm.mesh;
   small.rest = arm.mesh.rest / 100;  // the file's mesh space
   skin::Skeleton scaled = arm.skeleton;
