@@ -44,38 +44,6 @@ void ActiveSystem::lower_solve(const Eigen::Matrix3Xd& rhs, Eigen::Matrix3Xd& ou
   }
 }
 
-// The backward sweep of an iteration: p = z + beta p first (the last iteration's direction
-// update, deferred to here: row i reads only its own p), then t = l^-T p, and q = p - D t row
-// by row as each t is final.
-void ActiveSystem::backward_sweep(double beta, bool update_p) {
-  const auto n = static_cast<std::int64_t>(diagonal_.size());
-  for (std::int64_t i = n - 1; i >= 0; --i) {
-    if (update_p) p_.col(i) = z_.col(i) + beta * p_.col(i);
-    Eigen::Vector3d sum = p_.col(i);
-    for (std::int32_t j = upper_start_[std::size_t(i)]; j < upper_start_[std::size_t(i) + 1]; ++j)
-      sum.noalias() -= upper_[std::size_t(j)] * t_.col(upper_column_[std::size_t(j)]);
-    t_.col(i) = inverse_[std::size_t(i)] * sum;
-    q_.col(i) = p_.col(i) - diagonal_[std::size_t(i)] * t_.col(i);
-  }
-}
-
-// The forward sweep of an iteration: q = l^-1 q in place (row i reads only rows before it),
-// then each row's product l^-1 H l^-T p = q + t into t (t is not read again), and p . that,
-// summed in row order; returns the sum.
-double ActiveSystem::forward_sweep() {
-  const auto n = static_cast<std::int64_t>(diagonal_.size());
-  double pq = 0;
-  for (std::int64_t i = 0; i < n; ++i) {
-    Eigen::Vector3d sum = q_.col(i);
-    for (std::int32_t j = lower_start_[std::size_t(i)]; j < lower_start_[std::size_t(i) + 1]; ++j)
-      sum.noalias() -= lower_[std::size_t(j)] * q_.col(lower_column_[std::size_t(j)]);
-    q_.col(i) = inverse_[std::size_t(i)] * sum;
-    t_.col(i) = q_.col(i) + t_.col(i);
-    pq += p_.col(i).dot(t_.col(i));
-  }
-  return pq;
-}
-
 // CG on l^-1 H l^-T y = l^-1 b with the preconditioner D, step = l^-T y, where
 // l^-1 H l^-T p = t + l^-1 (p - D t), t = l^-T p: one forward and one backward sweep.
 int ActiveSystem::gauss_seidel_cg(const Eigen::Matrix3Xd& b, double relative_tolerance,
@@ -93,20 +61,26 @@ int ActiveSystem::gauss_seidel_cg(const Eigen::Matrix3Xd& b, double relative_tol
   }
   const double stop = relative_tolerance * std::sqrt(rz);
   int it = 0;
-  double beta = 0;
   while (it < max_iterations && std::sqrt(rz) > stop) {
-    backward_sweep(beta, it > 0);
-    const double pq = forward_sweep();  // t now holds l^-1 H l^-T p
+    lower_solve(p_, t_, false);  // t = l^-T p
+    for (Eigen::Index i = 0; i < n; ++i) q_.col(i) = p_.col(i) - diagonal_[std::size_t(i)] * t_.col(i);
+    lower_solve(q_, q_, true);  // in place: row i reads only rows before it
+    double pq = 0;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      q_.col(i) += t_.col(i);
+      pq += p_.col(i).dot(q_.col(i));
+    }
     if (!(pq > 0)) break;
     const double alpha = rz / pq;
     double rz_next = 0;
     for (Eigen::Index i = 0; i < n; ++i) {
       y_.col(i) += alpha * p_.col(i);
-      r_.col(i) -= alpha * t_.col(i);
+      r_.col(i) -= alpha * q_.col(i);
       z_.col(i) = diagonal_[std::size_t(i)] * r_.col(i);
       rz_next += r_.col(i).dot(z_.col(i));
     }
-    beta = rz_next / rz;
+    const double beta = rz_next / rz;
+    for (Eigen::Index i = 0; i < n; ++i) p_.col(i) = z_.col(i) + beta * p_.col(i);
     rz = rz_next;
     ++it;
   }

@@ -35,10 +35,6 @@ class ActiveSystem {
  private:
   // out = l^-1 rhs (forward) or l^-T rhs (backward), l = D + L; out may be rhs.
   void lower_solve(const Eigen::Matrix3Xd& rhs, Eigen::Matrix3Xd& out, bool forward) const;
-  // One iteration's two sweeps, each with the vector updates that read the rows it has just
-  // finished fused in (one pass over the rows instead of three); see gauss_seidel_cg.
-  void backward_sweep(double beta, bool update_p);
-  double forward_sweep();
 
   std::vector<std::int32_t> local_;  // per vertex: its index among the active, or -1
   std::vector<std::int32_t> lower_start_, lower_column_, upper_start_, upper_column_;
