@@ -14,7 +14,7 @@ namespace conform::scenes {
 using Json = nlohmann::json;
 using Vec3 = Eigen::Vector3d;
 
-BindPose::BindPose(const mesh::SkinnedMesh& mesh) : positions(mesh.current) {
+BindPose::BindPose(const mesh::SkinnedMesh& mesh) : positions(mesh.current), faces(mesh.faces) {
   if (positions.cols() == 0) return;
   lo = positions.rowwise().minCoeff();
   hi = positions.rowwise().maxCoeff();
@@ -32,18 +32,15 @@ std::int32_t BindPose::bone_near(const Vec3& p) const {
 }
 
 BoneCarrier::BoneCarrier(const bullet::SkinnedSoftBody& body, const BindPose& bind,
-                         const std::string& bone, const Vec3& near, const std::string& key)
+                         std::int32_t bone, const Vec3& near)
     : body_(body) {
   const skin::Skeleton& sk = body.skeleton();
-  bone_ = bone.empty() ? bind.bone_near(near) : sk.find_bone(bone);
-  if (bone_ < 0)
-    throw std::runtime_error("key '" + key + "', value \"" + bone + "\": no bone of that name (" +
-                             std::to_string(sk.bone_count()) + " bones)");
+  bone_ = bone < 0 ? bind.bone_near(near) : bone;
   std::vector<skin::Versor> global(static_cast<std::size_t>(sk.joint_count()));
   skin::global_versors(sk, skin::Pose::rest(sk), global);
   const skin::Bone& b = sk.bones[static_cast<std::size_t>(bone_)];
   const auto inverse = (global[static_cast<std::size_t>(b.joint)] * b.offset).inverse();
-  if (!inverse) throw std::runtime_error(key + ": bone " + b.name + " has no inverse bind versor");
+  if (!inverse) throw std::runtime_error("bone " + b.name + " has no inverse bind versor");
   from_bind_ = *inverse;
 }
 
@@ -69,13 +66,27 @@ const std::string& BoneCarrier::bone_name() const {
 }
 
 namespace {
-// cut.region: "nearest" (the section nearest cut.seed, by default cut.point) or "everywhere"
-// (the unbounded plane).
+
+// The box's keys without its point (`box_key`) are refused on a limb; a limb's keys in the box
+// (the scene's defaults hold them) are read and left unused.
+void refuse_box_keys(Reader& r, bool on_limb, std::initializer_list<const char*> box_keys,
+                     const char* box_key) {
+  if (!on_limb) return;
+  for (const char* k : box_keys)
+    if (r.has(k))
+      r.fail(k, nullptr,
+             std::string("places the edit in the bounding box: give ") + box_key +
+                 " too, or leave it out to aim at a limb");
+}
+
+// cut.region: "nearest" (the section nearest cut.seed, by default cut.point, or on a limb its
+// axis point) or "everywhere" (the unbounded plane).
 void read_region(Reader& r, CutEdit& e) {
   const std::string region = r.text("region", "nearest", {"nearest", "everywhere"});
   e.region = region == "nearest" ? CutEdit::Region::nearest : CutEdit::Region::everywhere;
-  e.seed = r.vec3("seed", e.point);
+  if (!e.on_limb) e.seed = r.vec3("seed", e.point);
 }
+
 }  // namespace
 
 CutEdit read_cut(Reader& root) {
@@ -84,15 +95,38 @@ CutEdit read_cut(Reader& root) {
   e.enabled = r.boolean("enabled", d.enabled);
   e.at = r.number("at", d.at, 0, 1e5);
   e.bone = r.text("bone", d.bone);
-  e.point = r.vec3("point", d.point);
-  e.normal = r.vec3("normal", d.normal);
-  if (!(e.normal.norm() > 1e-9)) r.fail("normal", Json{0, 0, 0}, "must not be zero");
+  e.on_limb = !r.has("point");
+  refuse_box_keys(r, e.on_limb, {"normal", "seed"}, "cut.point");
+  e.along = r.number("along", d.along, 0, 1);  // in the box: unused
+  if (!e.on_limb) {
+    e.point = r.vec3("point", d.point);
+    e.normal = r.vec3("normal", d.normal);
+    if (!(e.normal.norm() > 1e-9)) r.fail("normal", Json{0, 0, 0}, "must not be zero");
+  }
   e.cap = r.boolean("cap", d.cap);
   read_region(r, e);
   e.sever = read_sever(r, d.sever);
   r.finish();
   return e;
 }
+
+namespace {
+void read_tear_on_limb(Reader& r, TearEdit& e, const TearEdit& d) {
+  e.along = r.number("along", d.along, 0, 1);
+  e.length = r.number("length", d.length, 0, 1e3);
+  e.outer = r.text("side", d.outer ? "outer" : "inner", {"outer", "inner"}) == "outer";
+  e.depth = r.number("depth", d.depth, 0.01, 10);
+}
+void read_tear_in_box(Reader& r, TearEdit& e, const TearEdit& d) {
+  e.from = r.vec3("from", d.from);
+  e.to = r.vec3("to", d.to);
+  e.blade_a = r.vec3("blade_a", d.blade_a);
+  e.blade_b = r.vec3("blade_b", d.blade_b);
+  if ((e.blade_a - e.blade_b).norm() < 1e-9)
+    r.fail("blade_b", Json{e.blade_b.x(), e.blade_b.y(), e.blade_b.z()},
+           "the blade's two ends must differ");
+}
+}  // namespace
 
 TearEdit read_tear(Reader& root) {
   Reader r = root.object("tear");
@@ -102,13 +136,10 @@ TearEdit read_tear(Reader& root) {
   e.duration = r.number("duration", d.duration, 0, 1e5);
   e.samples = r.integer("samples", d.samples, 2, 100000);
   e.bone = r.text("bone", d.bone);
-  e.from = r.vec3("from", d.from);
-  e.to = r.vec3("to", d.to);
-  e.blade_a = r.vec3("blade_a", d.blade_a);
-  e.blade_b = r.vec3("blade_b", d.blade_b);
-  if ((e.blade_a - e.blade_b).norm() < 1e-9)
-    r.fail("blade_b", Json{e.blade_b.x(), e.blade_b.y(), e.blade_b.z()},
-           "the blade's two ends must differ");
+  e.on_limb = !r.has("from");
+  refuse_box_keys(r, e.on_limb, {"to", "blade_a", "blade_b"}, "tear.from");
+  read_tear_on_limb(r, e, d);  // in the box: unused
+  if (!e.on_limb) read_tear_in_box(r, e, d);
   r.finish();
   return e;
 }
@@ -119,30 +150,42 @@ DrillEdit read_drill(Reader& root) {
   e.enabled = r.boolean("enabled", d.enabled);
   e.at = r.number("at", d.at, 0, 1e5);
   e.bone = r.text("bone", d.bone);
-  e.tip = r.vec3("tip", d.tip);
-  e.base = r.vec3("base", d.base);
-  if ((e.tip - e.base).norm() < 1e-9)
-    r.fail("tip", Json{e.tip.x(), e.tip.y(), e.tip.z()}, "must differ from base");
-  e.radius = r.number("radius", d.radius, 1e-5, 0.5);
+  e.on_limb = !r.has("tip");
+  refuse_box_keys(r, e.on_limb, {"base", "radius"}, "drill.tip");
+  e.along = r.number("along", d.along, 0, 1);  // in the box: unused
+  e.limb_radius = r.number("radius_of_limb", d.limb_radius, 1e-3, 0.95);
+  if (!e.on_limb) {
+    e.tip = r.vec3("tip", d.tip);
+    e.base = r.vec3("base", d.base);
+    if ((e.tip - e.base).norm() < 1e-9)
+      r.fail("tip", Json{e.tip.x(), e.tip.y(), e.tip.z()}, "must differ from base");
+    e.radius = r.number("radius", d.radius, 1e-5, 0.5);
+  }
   e.tube = r.boolean("tube", d.tube);
   r.finish();
   return e;
 }
 
-Json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, const CutEdit& edit) {
-  const Vec3 p = bind.point(edit.point);
-  const BoneCarrier carrier(body, bind, edit.bone, p, "cut.bone");
+Json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, const PlacedCut& at,
+               const CutEdit& edit) {
   const std::int32_t before = body.vertex_count(), pieces_before = body.piece_count();
   mesh::CutOptions options;
   options.cap = edit.cap;
-  // The seed is carried by the cut's bone, like the plane, so it stays on the aimed limb.
-  if (edit.region == CutEdit::Region::nearest)
-    options.region = mesh::CutRegion::seed(carrier.point(bind.point(edit.seed)));
-  const auto plane =
-      cga::Plane<double>::from_normal_point(carrier.direction(p, edit.normal), carrier.point(p));
-  const mesh::CutResult r = body.cut(plane, options);
+  Vec3 point, normal, seed;
+  std::string bone;
+  if (at.section.near_ring.empty()) {
+    // The plane and seed are carried by the cut's bone, so they stay on the aimed limb.
+    const BoneCarrier carrier(body, bind, at.bone, at.point);
+    point = carrier.point(at.point), normal = carrier.direction(at.point, at.normal);
+    seed = carrier.point(at.seed), bone = carrier.bone_name();
+  } else {  // the limb's section as the skin holds it now
+    const Section s = at.section.now(body);
+    point = seed = s.centre, normal = s.axis;
+  }
+  if (edit.region == CutEdit::Region::nearest) options.region = mesh::CutRegion::seed(seed);
+  const mesh::CutResult r = body.cut(cga::Plane<double>::from_normal_point(normal, point), options);
   Json event = {{"status", r.status == mesh::CutStatus::Cut ? "cut" : "missed"},
-                {"bone", carrier.bone_name()},
+                {"bone", bone},
                 {"crossed_edges", r.crossed_edges},
                 {"new_vertices", body.vertex_count() - before},
                 {"loops", r.loops},
@@ -150,8 +193,9 @@ Json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, const CutEdi
                 {"cap_faces", r.cap_faces},
                 {"new_pieces", body.piece_count() - pieces_before},
                 {"region", edit.region == CutEdit::Region::nearest ? "nearest" : "everywhere"}};
+  if (edit.on_limb) event["limb"] = at.limb, event["along"] = edit.along;
   if (edit.region == CutEdit::Region::nearest) {
-    event["seed"] = {edit.seed.x(), edit.seed.y(), edit.seed.z()};
+    if (!edit.on_limb) event["seed"] = {edit.seed.x(), edit.seed.y(), edit.seed.z()};
     event["sections"] = r.sections;  // where the plane meets the body
     event["kept_sections"] = r.kept_sections;
   }
@@ -161,14 +205,12 @@ Json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, const CutEdi
 
 void TearRun::advance(bullet::SkinnedSoftBody& body, double t, GeometricTear* copy) {
   for (; next_ < edit_.samples && event_due(t, edit_.time(next_)); ++next_) {
-    const double u = edit_.samples > 1 ? double(next_) / (edit_.samples - 1) : 0.0;
-    const Vec3 p = bind_.point((1 - u) * edit_.from + u * edit_.to);
-    const BoneCarrier carrier(body, bind_, edit_.bone, bind_.point(edit_.from), "tear.bone");
-    if (next_ == 0) body.begin_tear(), bone_ = carrier.bone_name();
-    const mesh::ScalpelSample s{t, carrier.point(p + bind_.offset(edit_.blade_a)),
-                                carrier.point(p + bind_.offset(edit_.blade_b))};
+    if (next_ == 0) body.begin_tear();
+    const mesh::ScalpelSample s = sample(body, t);
     extended_ += body.tear_advance(s).extended;
-    if (copy) copy->advance(s);
+    // The copy takes the same stroke: in the box the same blade; on a limb the blade held by
+    // its own skin, so that it owes nothing to the physics.
+    if (copy) copy->advance(at_.anchors.empty() ? s : copy_sample(*copy, t));
     const mesh::Tear* tear = body.tear();
     if (next_ + 1 == edit_.samples && tear && tear->started()) {
       // Where the tear ends against where the blade ended: the segment's nearest point.
@@ -179,9 +221,29 @@ void TearRun::advance(bullet::SkinnedSoftBody& body, double t, GeometricTear* co
   }
 }
 
+mesh::ScalpelSample TearRun::sample(const bullet::SkinnedSoftBody& body, double t) {
+  const auto i = static_cast<std::size_t>(next_);
+  if (at_.anchors.empty()) {  // in the box: carried by one bone from the bind pose
+    const BoneCarrier carrier(body, bind_, at_.bone[i], at_.blade_a[i]);
+    if (next_ == 0) bone_ = carrier.bone_name();
+    return {t, carrier.point(at_.blade_a[i]), carrier.point(at_.blade_b[i])};
+  }
+  // On the skin as it is now: the anchor's face crossed along its normal.
+  const auto [a, b] = at_.anchors[i].blade(body);
+  return {t, a, b};
+}
+
+mesh::ScalpelSample TearRun::copy_sample(const GeometricTear& copy, double t) const {
+  const Eigen::Matrix3Xd& x = copy.mesh().current;
+  const auto [a, b] = at_.anchors[static_cast<std::size_t>(next_)].blade(
+      [&](std::int32_t v) { return Vec3(x.col(v)); });
+  return {t, a, b};
+}
+
 Json TearRun::summary(const bullet::SkinnedSoftBody& body) const {
   const mesh::Tear* tear = body.tear();
   Json j = {{"bone", bone_},
+            {"placement", edit_.on_limb ? "limb" : "box"},
             {"samples", next_},
             {"extending_samples", extended_},
             // The first sample starts the tear; every later one should extend it.
@@ -191,22 +253,38 @@ Json TearRun::summary(const bullet::SkinnedSoftBody& body) const {
             // The tip's distance from the last blade when it was applied, relative to the
             // bind pose's diagonal (−1: the tear never started).
             {"tip_to_last_blade_rel", tip_to_blade_ < 0 ? -1.0 : tip_to_blade_ / bind_.diagonal()}};
+  if (edit_.on_limb) j["limb"] = at_.limb;
   if (tear && !tear->message().empty()) j["message"] = tear->message();
   return j;
 }
 
-Json apply_drill(bullet::SkinnedSoftBody& body, const BindPose& bind, const DrillEdit& edit) {
-  const Vec3 tip = bind.point(edit.tip), base = bind.point(edit.base);
-  const BoneCarrier carrier(body, bind, edit.bone, 0.5 * (tip + base), "drill.bone");
-  const double radius = edit.radius * bind.diagonal() * carrier.scale();
+mesh::DrillTool drill_through(const PlacedDrill& at, const Section& s) {
+  // Across the limb's axis and its outward side (a sheet: along its normal).
+  const Vec3 through = at.section.flat ? s.side : Vec3(s.axis.cross(s.side).normalized());
+  const double reach = at.reach * s.scale;
+  return {s.centre + reach * through, s.centre - reach * through, at.radius * s.scale};
+}
+
+Json apply_drill(bullet::SkinnedSoftBody& body, const BindPose& bind, const PlacedDrill& at,
+                 const DrillEdit& edit) {
+  Vec3 tip, base;
+  double radius = 0;
+  std::string bone;
+  if (at.section.near_ring.empty()) {
+    const BoneCarrier carrier(body, bind, at.bone, 0.5 * (at.tip + at.base));
+    tip = carrier.point(at.tip), base = carrier.point(at.base);
+    radius = at.radius * carrier.scale(), bone = carrier.bone_name();
+  } else {  // through the limb's section as the skin holds it now
+    const mesh::DrillTool tool = drill_through(at, at.section.now(body));
+    tip = tool.tip, base = tool.base, radius = tool.radius;
+  }
   const std::int32_t before = body.vertex_count();
   mesh::DrillOptions options;
   options.tube = edit.tube;
-  const mesh::DrillResult r =
-      body.drill({carrier.point(tip), carrier.point(base), radius}, options);
+  const mesh::DrillResult r = body.drill({tip, base, radius}, options);
   const double disc = std::numbers::pi * radius * radius;
   Json event = {{"status", r.holes > 0 ? "drilled" : "missed"},
-                {"bone", carrier.bone_name()},
+                {"bone", bone},
                 {"radius", radius},
                 {"holes", r.holes},
                 {"tubes", r.tubes},
@@ -216,6 +294,7 @@ Json apply_drill(bullet::SkinnedSoftBody& body, const BindPose& bind, const Dril
                 // The area removed per hole against the disc πr² (1 on a flat wall).
                 {"area_per_hole_vs_disc", r.holes > 0 ? r.removed_area / (r.holes * disc) : 0.0},
                 {"detached_vertices", body.detached_count()}};
+  if (edit.on_limb) event["limb"] = at.limb, event["along"] = edit.along;
   if (!r.message.empty()) event["message"] = r.message;
   return event;
 }

@@ -20,12 +20,14 @@
 #include <nlohmann/json.hpp>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "base/scene_config.hpp"
 #include "conform/bullet/skinned_soft_body.hpp"
 #include "kinds/falling_pieces.hpp"
 #include "kinds/geometric_tear.hpp"
+#include "kinds/skin_frame.hpp"
 
 namespace conform::scenes {
 
@@ -33,6 +35,7 @@ namespace conform::scenes {
 /// vertex's dominant bone.
 struct BindPose {
   Eigen::Matrix3Xd positions;
+  std::vector<mesh::Face> faces;
   std::vector<std::int32_t> dominant_bone;  // per vertex: the bone of its largest weight
   Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();
   /// From an imported mesh, whose `current` positions are the bind pose.
@@ -48,10 +51,10 @@ struct BindPose {
 /// pose (and the body's world transform).
 class BoneCarrier {
  public:
-  /// `bone` names a bone of the body's skeleton; empty: the dominant bone of the bind-pose
-  /// vertex nearest `near`. Throws std::runtime_error naming `key` for an unknown bone.
-  BoneCarrier(const bullet::SkinnedSoftBody& body, const BindPose& bind, const std::string& bone,
-              const Eigen::Vector3d& near, const std::string& key);
+  /// `bone` indexes the body's skeleton's bones; −1: the dominant bone of the bind-pose
+  /// vertex nearest `near`.
+  BoneCarrier(const bullet::SkinnedSoftBody& body, const BindPose& bind, std::int32_t bone,
+              const Eigen::Vector3d& near);
   Eigen::Vector3d point(const Eigen::Vector3d& bind) const;
   /// The unit direction that `direction` at `at` becomes.
   Eigen::Vector3d direction(const Eigen::Vector3d& at, const Eigen::Vector3d& direction) const;
@@ -70,8 +73,10 @@ struct CutEdit {
   bool enabled = true;
   double at = 0.3;  // s
   std::string bone;
-  Eigen::Vector3d point{0.68, 0.39, 0.305};  // box fractions
-  Eigen::Vector3d normal{1, 0, -0.625};      // rest space
+  bool on_limb = true;  // aimed at a limb (edit_placement.hpp), else in the box
+  double along = 0.85;  // on the limb: where its section is cut, a fraction of its length
+  Eigen::Vector3d point{0.68, 0.39, 0.305};  // in the box: box fractions
+  Eigen::Vector3d normal{1, 0, -0.625};      // in the box: rest space
   bool cap = true;
   /// Which sections of the plane's meeting with the body are cut (mesh/cut_region.hpp):
   /// `nearest` the one nearest `seed` (a limb, not every limb the plane crosses), else all.
@@ -84,17 +89,47 @@ struct TearEdit {
   double at = 0.5, duration = 0.4;  // s
   int samples = 12;
   std::string bone;
-  Eigen::Vector3d from{0.1, 0.75, 1.0}, to{0.3, 0.75, 1.0};  // box fractions
-  Eigen::Vector3d blade_a{0, 0, 0.3}, blade_b{0, 0, -0.45};  // box offsets from the stroke
+  bool on_limb = true;
+  double along = 0.2;  // on the limb: where the stroke starts, a fraction of its length
+  double length = 0;   // on the limb: the stroke's length, m (0: 40 % of the limb's)
+  bool outer = true;   // on the limb: its side away from the model's centre, or toward it
+  double depth = 0.5;  // on the limb: the blade's reach either side of the skin, of its radius
+  Eigen::Vector3d from{0.1, 0.75, 1.0}, to{0.3, 0.75, 1.0};  // in the box: box fractions
+  Eigen::Vector3d blade_a{0, 0, 0.3}, blade_b{0, 0, -0.45};  // in the box: offsets
   double time(int i) const { return at + duration * i / std::max(1, samples - 1); }
 };
 struct DrillEdit {
   bool enabled = true;
   double at = 1.1;  // s
   std::string bone;
-  Eigen::Vector3d tip{0.6, 0.2, 0.68}, base{-0.2, 0.2, 0.68};  // box fractions
-  double radius = 0.03;                                        // of the box's diagonal
+  bool on_limb = true;
+  double along = 0.5;                                          // on the limb
+  Eigen::Vector3d tip{0.6, 0.2, 0.68}, base{-0.2, 0.2, 0.68};  // in the box: box fractions
+  double limb_radius = 0.3;  // on the limb: the drill's radius, of the limb's radius
+  double radius = 0.03;      // in the box: of the box's diagonal
   bool tube = true;
+};
+
+/// An edit's bind-pose geometry, and the bone that carries each part of it to the body's pose.
+struct PlacedCut {
+  Eigen::Vector3d point, normal, seed;
+  std::int32_t bone = -1;  // −1: the dominant bone of the bind-pose vertex nearest `point`
+  std::string limb;        // the aimed limb's root bone ("" in the box)
+  SkinSection section;     // on a limb: the section cut, held by the skin (else empty)
+};
+struct PlacedTear {
+  std::vector<Eigen::Vector3d> blade_a, blade_b;  // per sample (in the box)
+  std::vector<std::int32_t> bone;                 // per sample, as PlacedCut::bone (in the box)
+  std::vector<SkinAnchor> anchors;                // per sample (on a limb)
+  std::string limb;
+};
+struct PlacedDrill {
+  Eigen::Vector3d tip, base;
+  double radius = 0;  // bind-pose units
+  std::int32_t bone = -1;
+  std::string limb;
+  SkinSection section;  // on a limb: the section drilled through, held by the skin
+  double reach = 0;     // on a limb: from the section's centre to either end, bind-pose units
 };
 
 /// The "cut", "tear" and "drill" objects of a character scene (defaults placed on huesitos.fbx).
@@ -104,12 +139,14 @@ DrillEdit read_drill(Reader& root);
 
 /// The cut at the body's last pose; its summary entry ("status": "cut" or "missed": a plane
 /// placed for another model may miss the user's; the run goes on).
-nlohmann::json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, const CutEdit& edit);
+nlohmann::json apply_cut(bullet::SkinnedSoftBody& body, const BindPose& bind, const PlacedCut& at,
+                         const CutEdit& edit);
 
 /// The tear, sample by sample as the simulated time passes its sample times.
 class TearRun {
  public:
-  TearRun(const TearEdit& edit, const BindPose& bind) : edit_(edit), bind_(bind) {}
+  TearRun(const TearEdit& edit, PlacedTear at, const BindPose& bind)
+      : edit_(edit), at_(std::move(at)), bind_(bind) {}
   /// Advances every sample whose time is ≤ t (at the body's last pose), on the body and, when
   /// given, the same sample on its geometric copy (posed as the body's last pose).
   void advance(bullet::SkinnedSoftBody& body, double t, GeometricTear* copy = nullptr);
@@ -119,7 +156,10 @@ class TearRun {
   nlohmann::json summary(const bullet::SkinnedSoftBody& body) const;
 
  private:
+  mesh::ScalpelSample sample(const bullet::SkinnedSoftBody& body, double t);
+  mesh::ScalpelSample copy_sample(const GeometricTear& copy, double t) const;
   const TearEdit edit_;
+  const PlacedTear at_;
   const BindPose& bind_;
   int next_ = 0, extended_ = 0;
   double tip_to_blade_ = -1;  // the tip's distance from the last sample's blade, m
@@ -128,8 +168,11 @@ class TearRun {
 
 /// The drill at the body's last pose; its summary entry, with the removed area per hole against
 /// πr² ("status": "drilled" or "missed").
+/// The drill of a placement on a limb through its section `s` (as the skin holds it).
+mesh::DrillTool drill_through(const PlacedDrill& at, const Section& s);
+
 nlohmann::json apply_drill(bullet::SkinnedSoftBody& body, const BindPose& bind,
-                           const DrillEdit& edit);
+                           const PlacedDrill& at, const DrillEdit& edit);
 
 /// The seams of the file: rest positions shared by several of its vertices within one
 /// connected piece of skin, and the body's vertices that stand for them (one when the weld

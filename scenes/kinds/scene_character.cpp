@@ -16,6 +16,7 @@
 #include "conform/io/import.hpp"
 #include "conform/io/weld_model.hpp"
 #include "kinds/character_edits.hpp"
+#include "kinds/edit_placement.hpp"
 #include "kinds/event_time.hpp"
 #include "kinds/falling_pieces.hpp"
 #include "kinds/geometric_tear.hpp"
@@ -30,20 +31,19 @@ namespace {
 // The built-in scene `character`, the defaults of this kind (`conform scenes --show character`).
 constexpr const char* kCharacterJson = R"json({
   "scene": "character",
-  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body (nodes close to one bone ride it, blended regions follow their skinned targets softly) and, while it plays, its arm is cut off with a capped cut, its flank torn by a scalpel stroke and its base drilled through with a tube; the welded seams are measured for gaps. Units: the model is brought to metres, Y up, at import: model.units_per_metre file units make a metre (\"file\": the unit the file states, FBX's UnitScaleFactor, else 100), model.up (y or z) is the file's up axis (z is turned to y). Edits are placed on the bind pose: cut.point, cut.seed, tear.from, tear.to, drill.tip and drill.base as fractions of its bounding box, tear.blade_a and tear.blade_b as fractions of its size, drill.radius as a fraction of its diagonal, cut.normal in its axes (after model.up); material.margin is in metres, physics.gravity in m/s^2; every length in summary.json is in metres. model.animation = none plays the bind pose (what a model without animation does). cut.region = nearest cuts only the section of the plane nearest cut.seed (by default cut.point), everywhere the unbounded plane. cut.release lets the pieces the cut severs fall (released from skinning; a closed, capped piece keeps its volume with the bulk modulus cut.volume_modulus, Pa) onto the ground (ground.enabled; ground.height in metres, by default the bind pose's lowest point), which only released pieces meet (summary.json: released_pieces, metrics.csv: released_lowest_m, falling.png). The tear's physical opening is compared with a geometric copy: the same stroke on the animated mesh alone (CGA-skinned, no physics; the cut and the drill are not applied to it), opened by Algorithm 2 step 6 once the stroke ends by geometric.amount, a fraction of the bind pose's diagonal (summary.json: metrics.physics and metrics.geometric, max_opening in metres); profiles.points positions along the tear, profiles.snapshots profile snapshots (profiles.csv, profile_history.csv, geometric_*.ply frames, two-panel pictures). The pictures are coloured by the gap across the lips (render.scalar = gap): an imported model's rest positions are in its mesh space, whose scale need not be the bind pose's, so an edge strain against them (stretch) would not be the skin's.",
+  "description": "huesitos.fbx from Debian's assimp-testmodels (9 bones, animated) plays its animation through CGA skinning as a Bullet soft body with the membrane skin (material.model = bullet_links for Bullet's links; nodes close to one bone ride it, blended regions follow their skinned targets softly) and, while it plays, a limb is cut off with a capped cut, torn by a scalpel stroke and drilled through with a tube; the welded seams are measured for gaps. Units: the model is brought to metres, Y up, at import: model.units_per_metre file units make a metre (\"file\": the unit the file states, FBX's UnitScaleFactor, else 100), model.up (y or z) is the file's up axis (z is turned to y). Edits are aimed at a limb of the model (its bind pose): by default the limb (a bone and every bone below it) where a trial on the skinned model without physics caps the cut, extends the tear and lands the drill best, else the one each edit's bone names (summary.json: limb). The cut is the limb's cross-section at cut.along (a fraction of its length from its root), bounded to that section; the tear's stroke runs on the limb's outer (tear.side: away from the model's centre) or inner side from tear.along over tear.length metres (0: 40 % of the limb), its blade crossing the skin tear.depth limb radii either side; the drill goes through the limb at drill.along, across its axis and its outward side, of radius drill.radius_of_limb limb radii. Each edit is held by the skin as it is at that moment (rings of the limb's vertices, a point of a face), not by a bone. Given cut.point, tear.from or drill.tip, that edit is placed in the bind pose's bounding box instead (its limb keys are then unused): cut.point, cut.seed, tear.from, tear.to, drill.tip and drill.base as fractions of the box, tear.blade_a and tear.blade_b as fractions of its size, drill.radius as a fraction of its diagonal, cut.normal in its axes (after model.up), carried by one bone (cut.bone, tear.bone, drill.bone, or the dominant bone of the nearest vertex). material.margin is in metres, physics.gravity in m/s^2; every length in summary.json is in metres. model.animation = none plays the bind pose (what a model without animation does). cut.region = nearest cuts only the section of the plane nearest the limb's axis (in the box: cut.seed, by default cut.point), everywhere the unbounded plane. cut.release lets the pieces the cut severs fall (released from skinning; a closed, capped piece keeps its volume with the bulk modulus cut.volume_modulus, Pa) onto the ground (ground.enabled; ground.height in metres, by default the bind pose's lowest point), which only released pieces meet (summary.json: released_pieces, metrics.csv: released_lowest_m, falling.png). The tear's physical opening is compared with a geometric copy: the same stroke on the animated mesh alone (CGA-skinned, no physics; the cut and the drill are not applied to it), opened by Algorithm 2 step 6 once the stroke ends by geometric.amount, a fraction of the bind pose's diagonal (summary.json: metrics.physics and metrics.geometric, max_opening in metres); profiles.points positions along the tear, profiles.snapshots profile snapshots (profiles.csv, profile_history.csv, geometric_*.ply frames, two-panel pictures). The pictures are coloured by the gap across the lips (render.scalar = gap): an imported model's rest positions are in its mesh space, whose scale need not be the bind pose's, so an edge strain against them (stretch) would not be the skin's.",
   "seed": 1,
   "duration": 1.56,
   "model": { "file": "/usr/share/assimp/models/FBX/huesitos.fbx", "animation": "0",
              "units_per_metre": "file", "up": "y", "weld": true },
-  "material": { "link_stiffness": 0.02, "target_stiffness": 2000, "target_damping": 20,
+  "material": { "model": "membrane", "link_stiffness": 0.02, "target_stiffness": 2000, "target_damping": 20,
                 "kinematic_weight": 0.95, "damping": 0.01 },
-  "cut": { "at": 0.3, "point": [0.68, 0.39, 0.305], "normal": [1, 0, -0.625], "cap": true,
-           "region": "nearest", "release": true, "volume_modulus": 100000 },
+  "cut": { "at": 0.3, "along": 0.85, "cap": true, "region": "nearest", "release": true,
+           "volume_modulus": 100000 },
   "ground": { "enabled": true },
-  "tear": { "at": 0.5, "duration": 0.4, "samples": 12, "from": [0.1, 0.75, 1.0],
-            "to": [0.3, 0.75, 1.0], "blade_a": [0, 0, 0.3], "blade_b": [0, 0, -0.45] },
-  "drill": { "at": 1.1, "tip": [0.6, 0.2, 0.68], "base": [-0.2, 0.2, 0.68], "radius": 0.03,
-             "tube": true },
+  "tear": { "at": 0.5, "duration": 0.4, "samples": 12, "along": 0.2, "length": 0,
+            "side": "outer", "depth": 0.5 },
+  "drill": { "at": 1.1, "along": 0.5, "radius_of_limb": 0.3, "tube": true },
   "geometric": { "amount": 0.01 },
   "profiles": { "snapshots": 6, "points": 41 },
   "physics": { "dt": 0.016666666666666666, "substeps": 2, "solver_iterations": 10,
@@ -86,6 +86,8 @@ struct RunState {
   double worst_offset = 0, mean_offset_sum = 0, worst_seam_gap = 0;
   FirstStep first{};
   Json cut, tear, drill;
+  PlacedCut cut_at;  // where the edits land, in the bind pose
+  PlacedDrill drill_at;
   bool cut_done = false, drill_done = false;
   double edit_ms = 0, physics_ms = 0;
   FallingPieces falling;     // the pieces the cut severs (cut.release)
@@ -138,10 +140,9 @@ class Character final : public Scene {
     import_.weld = false;    // welded here, to keep the file's seams for the gap measure
     model.finish();
     bullet::Material d;
-    // Real characters come at any scale (units_per_metre) and their animations stretch the
-    // skin far from the bind pose; the SI membrane on them is not validated yet, so this scene
-    // keeps Bullet's soft links (material.model = "membrane" to try it).
-    d.model = bullet::MaterialModel::bullet_links;
+    // The membrane skin, in its rest state the bind pose; Bullet's links are an option, with
+    // the link fields below.
+    d.model = bullet::MaterialModel::membrane;
     d.kinematic_weight = 0.95;  // nodes near one bone ride it; blended regions jiggle
     // The animation stretches the skin (edge lengths change), which stiff links at bind-pose
     // rest lengths would fight: soft links, and a firm pull toward the skinned targets.
@@ -189,7 +190,13 @@ class Character final : public Scene {
     body.snap_to_pose();
     const BindPose bind(model.mesh);
     const SeamGap seams(file_rest, file_faces, mesh_of, weld.vertex_map);
-    TearRun tear(tear_, bind);
+    RunState s;
+    const std::int32_t aim =
+        auto_aim(model.mesh, bind, model.skeleton, animation, cut_, tear_, drill_);
+    if (cut_.enabled) s.cut_at = place_cut(cut_, bind, model.skeleton, aim);
+    if (drill_.enabled) s.drill_at = place_drill(drill_, bind, model.skeleton, aim);
+    TearRun tear(tear_, tear_.enabled ? place_tear(tear_, bind, model.skeleton, aim) : PlacedTear{},
+                 bind);
     std::optional<TearCompare> compare;
     if (tear_.enabled)
       compare.emplace(model.mesh, OpeningProfiles(compare_.points, compare_.snapshots, tear_.at,
@@ -207,7 +214,6 @@ class Character final : public Scene {
                                      "geometric_area"});
     out.open_metrics(columns);
     if (compare) compare->profiles.open_history(out);
-    RunState s;
     std::optional<Ground> ground;
     if (ground_.enabled) {
       // By default under the bind pose's lowest point: what the character stands on.
@@ -310,7 +316,7 @@ class Character final : public Scene {
             TearCompare* compare, double t, RunState& s) const {
     if (cut_.enabled && !s.cut_done && event_due(t, cut_.at)) {
       s.falling.before_cut(body);
-      s.cut = apply_cut(body, bind, cut_);
+      s.cut = apply_cut(body, bind, s.cut_at, cut_);
       s.cut_done = true;
       if (s.cut["status"] != "cut") std::cerr << "warning: the cut missed the model\n";
       if (releases() && s.cut["status"] == "cut")
@@ -318,7 +324,7 @@ class Character final : public Scene {
     }
     if (tear_.enabled) advance_tear(body, bind, tear, compare, t);
     if (drill_.enabled && !s.drill_done && event_due(t, drill_.at)) {
-      s.drill = apply_drill(body, bind, drill_);
+      s.drill = apply_drill(body, bind, s.drill_at, drill_);
       s.drill_done = true;
       if (s.drill["status"] != "drilled") std::cerr << "warning: the drill missed the model\n";
     }

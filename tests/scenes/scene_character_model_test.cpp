@@ -166,7 +166,7 @@ TEST(CharacterCutRegion, AnArmCutSeversTheArmOnly) {
   const std::string file = kModels + "X/BCN_Epileptic.X";
   if (!fs::exists(file)) GTEST_SKIP() << "no assimp-testmodels";
   const std::string args =
-      "--set duration=0.35 --set tear.enabled=false "
+      "--set duration=0.35 --set tear.enabled=false --set material.model=bullet_links "
       "--set drill.enabled=false --set model.file=" +
       file + " --set cut.point=[0.05,0.65,0.5] --set cut.normal=[0,1,0]";
   const Outcome bounded = run(args, "region_nearest");
