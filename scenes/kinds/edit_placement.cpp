@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 
 #include "conform/mesh/cut.hpp"
@@ -30,19 +31,44 @@ std::vector<bool> bones_below(const skin::Skeleton& sk, std::int32_t bone) {
   return below;
 }
 
+// The largest connected piece of the vertices `in` marks (joined by faces wholly among them):
+// a limb is one piece of skin, not separate objects on one branch of the skeleton.
+std::vector<std::int32_t> largest_piece(const BindPose& bind, const std::vector<bool>& in) {
+  const auto n = static_cast<std::size_t>(bind.positions.cols());
+  std::vector<std::int32_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&](std::int32_t v) {
+    while (parent[std::size_t(v)] != v)
+      v = parent[std::size_t(v)] = parent[std::size_t(parent[std::size_t(v)])];
+    return v;
+  };
+  for (const mesh::Face& f : bind.faces)
+    if (in[std::size_t(f[0])] && in[std::size_t(f[1])] && in[std::size_t(f[2])])
+      parent[std::size_t(find(f[1]))] = find(f[0]), parent[std::size_t(find(f[2]))] = find(f[0]);
+  std::vector<std::int32_t> size(n, 0);
+  for (std::size_t v = 0; v < n; ++v)
+    if (in[v]) ++size[std::size_t(find(std::int32_t(v)))];
+  const auto root = std::int32_t(std::max_element(size.begin(), size.end()) - size.begin());
+  std::vector<std::int32_t> out;
+  for (std::size_t v = 0; v < n; ++v)
+    if (in[v] && find(std::int32_t(v)) == root) out.push_back(std::int32_t(v));
+  return out;
+}
+
 std::vector<std::int32_t> limb_vertices(const BindPose& bind, const skin::Skeleton& sk,
                                         std::int32_t bone) {
-  std::vector<std::int32_t> out;
-  if (bone < 0) {
-    for (std::int32_t v = 0; v < bind.positions.cols(); ++v) out.push_back(v);
-    return out;
+  if (bone < 0) {  // the whole model, every piece of it
+    std::vector<std::int32_t> all(static_cast<std::size_t>(bind.positions.cols()));
+    std::iota(all.begin(), all.end(), 0);
+    return all;
   }
+  std::vector<bool> in(static_cast<std::size_t>(bind.positions.cols()));
   const std::vector<bool> below = bones_below(sk, bone);
-  for (std::int32_t v = 0; v < bind.positions.cols(); ++v) {
-    const std::int32_t b = bind.dominant_bone[static_cast<std::size_t>(v)];
-    if (b >= 0 && below[static_cast<std::size_t>(b)]) out.push_back(v);
+  for (std::size_t v = 0; v < in.size(); ++v) {
+    const std::int32_t b = bind.dominant_bone[v];
+    in[v] = b >= 0 && below[static_cast<std::size_t>(b)];
   }
-  return out;
+  return largest_piece(bind, in);
 }
 
 // The principal axes of the vertices (columns, largest variance last) and their variances.
@@ -212,14 +238,14 @@ std::int32_t border_edges(const BindPose& bind, const Limb& limb) {
 }  // namespace
 
 std::vector<std::int32_t> limb_candidates(const BindPose& bind, const skin::Skeleton& sk) {
-  // Limbs, not the body and not slivers: between 2 % and 60 % of the vertices (at least 8).
+  // Limbs, not the body and not slivers: between 1 % and 60 % of the vertices (at least 8).
   // First those whose skin is closed (no border edge: a tear's walk stops at a border), then
   // the elongated ones (principal spread over the next ≥ 2), then the thickest.
   const double n = double(bind.positions.cols());
   std::vector<std::pair<std::array<double, 3>, std::int32_t>> scored;
   for (std::int32_t b = 0; b < sk.bone_count(); ++b) {
     const double m = double(limb_vertices(bind, sk, b).size());
-    if (m < std::max(8.0, 0.02 * n) || m > 0.6 * n) continue;
+    if (m < std::max(8.0, 0.01 * n) || m > 0.6 * n) continue;
     const Limb limb = limb_of(bind, sk, b, "aim");
     const Eigen::Vector3d variance = principal_axes(bind, limb.vertices, limb.centre).eigenvalues();
     const bool elongated = variance(2) >= 4 * variance(1);
@@ -298,7 +324,9 @@ std::int32_t auto_aim(const mesh::SkinnedMesh& mesh, const BindPose& bind, const
   // that extend it; the first of equals.
   std::int32_t best = -1;
   double best_score = -1;
-  for (const std::int32_t b : limb_candidates(bind, sk)) {
+  std::vector<std::int32_t> candidates = limb_candidates(bind, sk);
+  candidates.push_back(-1);  // the whole model last
+  for (const std::int32_t b : candidates) {
     const Limb limb = limb_of(bind, sk, b, "aim");
     TearEdit on_limb = tear;
     on_limb.on_limb = true, on_limb.bone.clear();

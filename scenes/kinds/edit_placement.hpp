@@ -1,12 +1,13 @@
 // Where the character scene's edits land on a user's model, in its bind pose. By default an
-// edit is aimed at a limb: a bone and every bone below it, the vertices they dominate, with the
-// limb's principal axis (pointing away from its root joint), its extent along it and its radius
-// about it. The cut is the limb's cross-section at a fraction `along` of its length; the tear's
-// blade runs along the limb's outer side (or inner side), snapped to the nearest point of the
-// limb's skin sample by sample and crossing it along the skin's normal; the drill goes through
-// the limb across its axis (through a flat part along its normal). Without a named bone the
-// limb is the model's most elongated part (no limb: the whole model). Given `cut.point`,
-// `tear.from` or `drill.tip`, an edit is placed in the bind pose's bounding box as before.
+// edit is aimed at a limb: a bone and every bone below it, the largest connected piece of the
+// vertices they dominate, with the limb's principal axis (pointing away from its root joint), its
+// extent along it and its radius about it. The cut is the limb's cross-section at a fraction
+// `along` of its length; the tear's blade runs along the limb's outer side (or inner side), snapped
+// to the nearest point of the limb's skin sample by sample and crossing it along the skin's normal;
+// the drill goes through the limb across its axis (through a flat part along its normal). Without a
+// named bone the limb is the one where a trial on the skinned model lands the edits best (no limb:
+// the model's largest piece). Given `cut.point`, `tear.from` or `drill.tip`, an edit is placed in
+// the bind pose's bounding box as before.
 #pragma once
 
 #include <Eigen/Core>
@@ -46,14 +47,14 @@ std::int32_t named_bone(const skin::Skeleton& skeleton, const std::string& name,
                         const std::string& key);
 /// The root bone's name, or "(the whole model)" for −1.
 std::string limb_name(const skin::Skeleton& skeleton, std::int32_t bone);
-/// Bones whose limbs are limbs (between 2 % and 60 % of the vertices, at least 8), the most
-/// elongated first.
+/// Bones whose limbs are limbs (between 1 % and 60 % of the vertices, at least 8): those
+/// without an open border first, then the elongated ones, then the thickest.
 std::vector<std::int32_t> limb_candidates(const BindPose& bind, const skin::Skeleton& skeleton);
 /// The limb edits aim at by default, tried on `mesh` skinned as `animation` (none: the bind
 /// pose) has it at the edits' times, without physics: the candidate whose section at
 /// `cut.along` closes as one capped loop, whose tear (`tear`'s stroke on the limb) extends at
-/// the most samples and whose drill lands (with its tube), the first of equals; −1 (the whole
-/// model) when there is no candidate.
+/// the most samples and whose drill lands (with its tube), the first of equals. The whole
+/// model (−1) is the last candidate.
 std::int32_t auto_aim(const mesh::SkinnedMesh& mesh, const BindPose& bind,
                       const skin::Skeleton& skeleton, const skin::Animation* animation,
                       const CutEdit& cut, const TearEdit& tear, const DrillEdit& drill);

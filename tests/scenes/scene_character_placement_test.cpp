@@ -87,7 +87,7 @@ TEST(CharacterPlacement, TheThreeEditsLandOnRealModelsWithTheDefaults) {
   };
   const Case cases[] = {{"FBX/huesitos.fbx", true, 0.6},
                         {"FBX/animation_with_skeleton.fbx", true, 0.8},
-                        {"X/anim_test.x", true, 0.45},
+                        {"X/anim_test.x", true, 0.8},
                         {"SMD/WusonSMD.smd", true, 0.7},
                         {"glTF2/simple_skin/simple_skin.gltf", false, 0.8}};
   for (const Case& c : cases) {
