@@ -61,12 +61,17 @@ void BM_CharacterFrame(benchmark::State& state) {
   const std::string file = std::string("/usr/share/assimp/models/") + kModels[state.range(0)];
   if (!std::filesystem::exists(file)) return state.SkipWithError("no assimp-testmodels");
   Character ch(file, state.range(1) == 1);
-  double wall = 0;
+  double wall = 0, newton = 0, cg = 0;
   for (auto _ : state) {
     const auto t0 = std::chrono::steady_clock::now();
     ch.world->step();
     wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    newton += ch.body->last_solve().newton_iterations;
+    cg += ch.body->last_solve().cg_iterations;
   }
+  // The membrane's Newton and conjugate-gradient iterations per substep (its last one).
+  state.counters["newton"] = newton / double(state.iterations());
+  state.counters["cg"] = cg / double(state.iterations());
   // Simulated time over wall time: above 1 is faster than real time.
   state.counters["real_time"] =
       double(state.iterations()) * ch.world->dt * ch.world->substeps / wall;
