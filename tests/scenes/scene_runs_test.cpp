@@ -154,7 +154,16 @@ TEST(SceneDrill, TheRimStaysOnTheSkin) {
 TEST(SceneCharacter, RealModelIsCutTornAndDrilledWhileItPlays) {
   if (!fs::exists("/usr/share/assimp/models/FBX/huesitos.fbx"))
     GTEST_SKIP() << "assimp-testmodels is not installed";
-  const Json s = run("character", "", "character");
+  // Bullet's links, and the edits placed in the bind pose's bounding box for huesitos (the
+  // scene's placement before edits were aimed at limbs).
+  const Json s = run("character",
+                     "--set material.model=bullet_links "
+                     "--set cut.point=[0.68,0.39,0.305] --set cut.normal=[1,0,-0.625] "
+                     "--set tear.from=[0.1,0.75,1.0] --set tear.to=[0.3,0.75,1.0] "
+                     "--set tear.blade_a=[0,0,0.3] --set tear.blade_b=[0,0,-0.45] "
+                     "--set drill.tip=[0.6,0.2,0.68] --set drill.base=[-0.2,0.2,0.68] "
+                     "--set drill.radius=0.03",
+                     "character");
   ASSERT_TRUE(s.is_object());
   const Json& m = s["metrics"];
   EXPECT_EQ(m["vertices"].get<int>(), 62);  // 128 in the file, welded at its seams
@@ -217,14 +226,19 @@ TEST(SceneCharacter, SeamCopiesWeightedApartWeldWithTheirMeanAndStayClosed) {
   // they open (0.42 % of the diagonal measured).
   const std::string file = "/usr/share/assimp/models/X/Testwuson.X";
   if (!fs::exists(file)) GTEST_SKIP() << "assimp-testmodels is not installed";
-  const Json mean = run("character", "--set model.file=" + file, "character_wuson");
+  // Bullet's links: at the 100 units a metre the scene assumes for an X file Testwuson is 3 cm
+  // long, where the membrane's step is slow (docs/scenes.md); the seams are the weld's.
+  // Without the drill: on Testwuson's foreleg the links' step goes non-finite after it (an
+  // open defect, reported by name).
+  const std::string links = " --set material.model=bullet_links --set drill.enabled=false";
+  const Json mean = run("character", "--set model.file=" + file + links, "character_wuson");
   ASSERT_TRUE(mean.is_object());
   const Json& closed = mean["metrics"]["seams"];
   EXPECT_EQ(closed["mean_weight_positions"].get<int>(), 7);
   EXPECT_EQ(closed["open_positions"].get<int>(), 0);
   EXPECT_LE(closed["max_gap_rel"].get<double>(), 1e-6);
   const Json apart =
-      run("character", "--set model.file=" + file + " --set model.seam_weights=keep_apart",
+      run("character", "--set model.file=" + file + links + " --set model.seam_weights=keep_apart",
           "character_wuson_apart");
   ASSERT_TRUE(apart.is_object());
   const Json& open = apart["metrics"]["seams"];
