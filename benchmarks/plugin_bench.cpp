@@ -280,16 +280,9 @@ BENCHMARK(BM_OpeningTearStep)->Unit(benchmark::kMillisecond)->MinTime(1.0);
 // The default material against two baselines in the same run: Bullet's pre-tensioned links
 // (the tear-opening scene's link settings, the default before the membrane) and the membrane
 // at its previous solver settings (1 Pa, block-Jacobi CG); and the membrane with its Newton
-// systems solved in place rather than packed (packed_systems off: the same results); and the
-// membrane with its Newton systems solved directly (LinearSolver::sparse_ldlt) rather than by
-// conjugate gradients. The arm of `resolution` (1: 2.6k vertices, 2: 10k, 3: 23k).
-enum Variant {
-  kLinks = 0,
-  kMembrane = 1,
-  kMembranePrevious = 2,
-  kMembraneUnpacked = 3,
-  kMembraneDirect = 4
-};
+// systems solved in place rather than packed (packed_systems off: the same results). The arm of
+// `resolution` (1: 2.6k vertices, 2: 10k, 3: 23k).
+enum Variant { kLinks = 0, kMembrane = 1, kMembranePrevious = 2, kMembraneUnpacked = 3 };
 
 // The torn arm of tear-opening (its scene defaults: one 1/60 s substep a frame for the
 // membrane; two substeps of 1/120 s for the links). BM_StepTornArm: the stroke is done and the
@@ -323,8 +316,6 @@ struct TornArm {
     if (variant == kMembraneUnpacked) {
       material.solver.packed_systems = false;
     }
-    if (variant == kMembraneDirect)
-      material.solver.linear_solver = membrane::LinearSolver::sparse_ldlt;
     if (variant == kLinks)
       material = {.model = bullet::MaterialModel::bullet_links,
                   .damping = 0.02,
@@ -379,18 +370,15 @@ BENCHMARK(BM_StepTornArm)
     ->Args({kMembrane, 1, 1})
     ->Args({kMembrane, 1, 2})
     ->Args({kMembranePrevious, 1, 1})
-    ->Args({kMembraneDirect, 1, 1})
     ->Args({kLinks, 1, 1})
     ->Args({kMembrane, 2, 1})
     ->Args({kMembrane, 2, 2})
     ->Args({kMembranePrevious, 2, 1})
     ->Args({kMembraneUnpacked, 2, 1})
-    ->Args({kMembraneDirect, 2, 1})
     ->Args({kLinks, 2, 1})
     ->Args({kMembrane, 3, 1})
     ->Args({kMembrane, 3, 2})
     ->Args({kMembraneUnpacked, 3, 1})
-    ->Args({kMembraneDirect, 3, 1})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
 
@@ -513,8 +501,6 @@ int main(int argc, char** argv) {
                                 "membrane / its previous settings (1 Pa, Jacobi), " + what);
       conform::bench::add_ratio(name(kMembrane, "1"), name(kMembraneUnpacked, "1"),
                                 "membrane / unpacked Newton systems (same results), " + what);
-      conform::bench::add_ratio(name(kMembraneDirect, "1"), name(kMembrane, "1"),
-                                "membrane, direct Newton solve / SGS-CG, " + what);
       conform::bench::add_ratio(name(kMembrane, "1"), name(kLinks, "1"),
                                 "membrane / Bullet links (the default before), " + what);
       conform::bench::add_ratio(name(kMembrane, "2"), name(kMembrane, "1"),

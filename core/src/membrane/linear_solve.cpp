@@ -151,29 +151,10 @@ int packed_gauss_seidel_cg(Context& c) {
   return it;
 }
 
-// The active system factored and solved directly (DirectSystem); false if the factorisation
-// failed, and the step is left to the conjugate gradients.
-bool direct_solve(Context& c) {
-  Solver::Scratch& s = c.s;
-  const auto& list = s.active_list_;
-  if (!s.direct_.factor({c.model.block_start(), c.model.block_column(), c.model.diagonal_block(),
-                         s.blocks_, list, s.active_, c.model.build_id()}))
-    return false;
-  const auto na = static_cast<Eigen::Index>(list.size());
-  s.packed_rhs_.resize(3, na);
-  for (Eigen::Index i = 0; i < na; ++i)
-    s.packed_rhs_.col(i) = -s.gradient_.col(list[std::size_t(i)]);
-  s.direct_.solve(s.packed_rhs_, s.packed_step_);
-  s.step_.resize(3, c.nv);
-  for (Eigen::Index i = 0; i < na; ++i) s.step_.col(list[std::size_t(i)]) = s.packed_step_.col(i);
-  return true;
-}
-
 }  // namespace
 
 int solve_newton_system(Context& c) {
   Solver::Scratch& s = c.s;
-  if (c.settings.linear_solver == LinearSolver::sparse_ldlt && direct_solve(c)) return 0;
   if (c.settings.preconditioner == Preconditioner::symmetric_gauss_seidel &&
       c.settings.packed_systems) {
     s.step_.resize(3, c.nv);

@@ -10,7 +10,6 @@
 
 #include "active_system.hpp"
 #include "conform/membrane/solver.hpp"
-#include "direct_system.hpp"
 
 namespace conform::membrane {
 namespace solver_detail {
@@ -52,7 +51,6 @@ struct Solver::Scratch {
   Eigen::VectorXd inertia_weight_, node_residual_;
   ActiveSystem system_;  // the Newton system of the active nodes, packed
   Eigen::Matrix3Xd packed_rhs_, packed_step_;
-  DirectSystem direct_;  // the same, factored (LinearSolver::sparse_ldlt)
 };
 
 namespace solver_detail {
@@ -83,7 +81,7 @@ detail::ElementState state_at(const Context& c, std::int64_t e,
 void assemble(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x);
 
 // Phase 6 (linear_solve.cpp): step_ = the Newton step over the active nodes, H step = -g, as
-// the settings say; returns the conjugate-gradient iterations (0 for a direct solve).
+// the settings say; returns the conjugate-gradient iterations.
 int solve_newton_system(Context& c);
 
 }  // namespace solver_detail

@@ -16,18 +16,6 @@ enum class Preconditioner {
   symmetric_gauss_seidel,
 };
 
-/// How each Newton system is solved.
-enum class LinearSolver {
-  /// Conjugate gradients, preconditioned as SolverSettings::preconditioner says, to
-  /// cg_relative_tolerance.
-  conjugate_gradients,
-  /// Directly: a sparse LDL^T factorisation (Eigen's SimplicialLDLT, approximate minimum degree
-  /// ordering) of the active nodes' system, exact to rounding. The ordering and symbolic
-  /// analysis are kept while the model and the active set stay the same. Reports no CG
-  /// iterations; a system that does not factor falls back to conjugate gradients.
-  sparse_ldlt,
-};
-
 struct SolverSettings {
   /// Stop when the largest |nodal force| / (node area x S) over the free nodes is below this,
   /// where S is the material's stress scale (SkinMaterial::stress_scale: the larger pre-stress,
@@ -40,7 +28,6 @@ struct SolverSettings {
   /// Each Newton system is solved until its residual is below this fraction of the gradient.
   double cg_relative_tolerance = 0.05;
   Preconditioner preconditioner = Preconditioner::symmetric_gauss_seidel;
-  LinearSolver linear_solver = LinearSolver::conjugate_gradients;
   /// A Newton step moves only the free nodes near one whose residual exceeds
   /// max(relative_tolerance x S, local_fraction x the largest residual): after an edit the
   /// imbalance is local, and the rest of the mesh is already in balance to far better than it. In
