@@ -8,13 +8,11 @@
 
 #include <stdexcept>
 
-#include "active_system.hpp"
 #include "range_error.hpp"
+#include "solve_context.hpp"
 
 namespace conform::membrane {
 namespace {
-
-constexpr std::int64_t kParallelElements = 4096;  // below this, threads cost more than they save
 
 void require_cols(const Eigen::Ref<const Eigen::Matrix3Xd>& m, Eigen::Index cols, bool may_be_empty,
                   const char* name) {
@@ -40,68 +38,22 @@ void SolverSettings::validate() const {
   check(local_reach > 0 && std::isfinite(local_reach), "local_reach", local_reach, "> 0");
 }
 
-namespace {
-
-// What the gradient and the potential need of an element at given positions: its corner forces
-// (f1 = A t P beta_1 at corner 1, f2 = A t P beta_2 at corner 2, -(f1 + f2) at corner 0) and
-// its energy A t psi, J. 56 bytes against the full state's 400: the passes over every element
-// keep only these (the full state is rebuilt for the Hessian of the elements a step changes).
-struct ElementForces {
-  Eigen::Vector3d f1, f2;
-  double energy = 0;
-};
-
-}  // namespace
-
-struct Solver::Scratch {
-  std::vector<ElementForces> forces_;        // every element at x
-  std::vector<ElementForces> guess_forces_;  // every element at the alternative guess
-  std::vector<ElementForces> trial_forces_;  // of changed_ at trial_ (line search)
-  // The last solve's result and its elements' forces, of the model built as last_build_: an
-  // element whose corners are where they were then is not evaluated again (a body at rest, whose
-  // carried guess is the last solution, evaluates only its moving part).
-  std::vector<ElementForces> last_forces_;
-  Eigen::Matrix3Xd last_x_;
-  std::uint64_t last_build_ = 0;
-  std::vector<Eigen::Matrix3d> upper_;  // the changed elements' six upper Hessian blocks each
-  std::vector<Eigen::Matrix3d> node_stiffness_, block_inverse_, blocks_;
-  std::vector<std::uint8_t> free_;    // per vertex: may move in this solve
-  std::vector<std::uint8_t> active_;  // per vertex: moves in this Newton step (a subset of free_)
-  std::vector<std::int32_t> active_list_;        // the active vertices, ascending
-  std::vector<std::int32_t> changed_, touched_;  // elements with an active corner; their corners
-  std::vector<std::int32_t> changed_slot_;       // per element: its index in changed_, or -1
-  std::vector<std::uint8_t> node_mark_;
-  std::vector<std::int32_t> reached_, seed_of_;  // the active set's search (select_active)
-  Eigen::Matrix3Xd predicted_, gradient_, step_, r_, z_, p_, q_, trial_, trial_direction_;
-  Eigen::VectorXd inertia_weight_, node_residual_;
-  ActiveSystem system_;  // the Newton system of the active nodes, packed
-  Eigen::Matrix3Xd packed_rhs_, packed_step_;
-};
-
 Solver::Solver() : scratch_(std::make_unique<Scratch>()) {}
 Solver::~Solver() = default;
 Solver::Solver(Solver&&) noexcept = default;
 Solver& Solver::operator=(Solver&&) noexcept = default;
 
+namespace solver_detail {
+
+detail::ElementState state_at(const Context& c, std::int64_t e,
+                              const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
+  const mesh::Face& f = c.model.element_faces()[static_cast<std::size_t>(e)];
+  return detail::element_forces(c.model.elements()[static_cast<std::size_t>(e)], x.col(f[0]),
+                                x.col(f[1]), x.col(f[2]), c.model.lambda(), c.model.mu(),
+                                c.model.wrinkling());
+}
+
 namespace {
-
-// One solve's input, state and scratch, shared by its phases.
-struct Context {
-  const Model& model;
-  const StepInput& in;
-  const SolverSettings& settings;
-  Solver::Scratch& s;
-  std::int64_t nv = 0, ne = 0;
-  bool dynamic = false;
-  int threads = 1;
-  double tolerance = 0;  // Pa: relative_tolerance x the stress scale
-  bool reuse = false;    // last_forces_ are of this model's elements at last_x_
-
-  bool fixed(std::int64_t v) const {
-    return in.fixed[static_cast<std::size_t>(v)] != 0 || model.node_area(std::int32_t(v)) <= 0;
-  }
-  bool parallel() const { return threads > 1 && ne > kParallelElements; }
-};
 
 // Phase 1: nodal terms that do not change during the solve: attachment stiffness K_i and the
 // inertia-damping weight w_i = m_i / dt^2 + c A_i / dt with its anchor
@@ -137,14 +89,6 @@ void prepare_nodes(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
                              damping * (c.in.start.col(v) + dt * c.in.target_velocities.col(v))) /
                             w;
   }
-}
-
-detail::ElementState state_at(const Context& c, std::int64_t e,
-                              const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
-  const mesh::Face& f = c.model.element_faces()[static_cast<std::size_t>(e)];
-  return detail::element_forces(c.model.elements()[static_cast<std::size_t>(e)], x.col(f[0]),
-                                x.col(f[1]), x.col(f[2]), c.model.lambda(), c.model.mu(),
-                                c.model.wrinkling());
 }
 
 ElementForces forces_at(const Context& c, std::int64_t e,
@@ -341,264 +285,6 @@ void mark_changed(Context& c) {
     }
 }
 
-// Phase 5a: each changed element's six distinct Hessian blocks (a <= b) at x, into upper_
-// (parallel over the elements; the element's full state is rebuilt here, not kept).
-void element_hessians(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
-  Solver::Scratch& s = c.s;
-  const auto nc = static_cast<std::int64_t>(s.changed_.size());
-  s.upper_.resize(std::size_t(6 * nc));
-#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
-  for (std::int64_t k = 0; k < nc; ++k) {
-    const std::int32_t e = s.changed_[std::size_t(k)];
-    detail::ElementState state = state_at(c, e, x);
-    detail::add_hessian_terms(state);
-    detail::hessian_upper_blocks(c.model.elements()[std::size_t(e)], state, c.model.lambda(),
-                                 c.model.mu(), &s.upper_[std::size_t(6 * k)]);
-  }
-}
-
-constexpr int kPair[3][3] = {{0, 1, 2}, {1, 3, 4}, {2, 4, 5}};  // (a, b) -> upper_ index
-
-// Adds corner a's row of an element's blocks (its six upper ones, hessian_upper_blocks) to the
-// blocks of the element's row block a.
-void add_element_row(Context& c, std::int64_t e, int a, const Eigen::Matrix3d* upper) {
-  const auto& element_block = c.model.element_block();
-  for (int b = 0; b < 3; ++b) {
-    Eigen::Matrix3d& block =
-        c.s.blocks_[std::size_t(element_block[std::size_t(9 * e + 3 * a + b)])];
-    if (a <= b)
-      block += upper[kPair[a][b]];
-    else
-      block += upper[kPair[a][b]].transpose();
-  }
-}
-
-// The nodal attachment and inertia terms on row v's diagonal block, and its inverse.
-void finish_diagonal(Context& c, std::int32_t v) {
-  Solver::Scratch& s = c.s;
-  Eigen::Matrix3d& k = s.blocks_[std::size_t(c.model.diagonal_block()[std::size_t(v)])];
-  k += s.node_stiffness_[std::size_t(v)];
-  if (c.dynamic) k.diagonal().array() += s.inertia_weight_[v];
-  k.diagonal().array() += 1e-12 * k.trace() + 1e-300;  // a lone node stays invertible
-  s.block_inverse_[std::size_t(v)] = k.inverse();
-}
-
-// Phase 5b in parallel: each active row's blocks gathered from its elements' blocks (all
-// changed, as it is active; element_hessians) in ascending element order, so that the sums do
-// not depend on the thread count.
-void gather_hessians(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
-  Solver::Scratch& s = c.s;
-  element_hessians(c, x);
-  const auto& row_start = c.model.block_start();
-  const auto& start = c.model.incidence_start();
-  const auto& inc = c.model.incidence();
-  const auto na = static_cast<std::int64_t>(s.active_list_.size());
-#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
-  for (std::int64_t i = 0; i < na; ++i) {
-    const std::int32_t v = s.active_list_[std::size_t(i)];
-    for (std::int32_t j = row_start[std::size_t(v)]; j < row_start[std::size_t(v) + 1]; ++j)
-      s.blocks_[std::size_t(j)].setZero();
-    for (std::int32_t k = start[std::size_t(v)]; k < start[std::size_t(v) + 1]; ++k) {
-      const std::int32_t e = inc[std::size_t(k)] / 3, a = inc[std::size_t(k)] % 3;
-      add_element_row(c, e, a, &s.upper_[std::size_t(6 * s.changed_slot_[std::size_t(e)])]);
-    }
-    finish_diagonal(c, v);
-  }
-}
-
-// Phase 5b serially: the changed elements in ascending order, each one's blocks computed and
-// added straight to its active corners' rows. Every block receives the same terms in the same
-// (ascending element) order as in gather_hessians, so the sums are the same bit for bit,
-// without the round trip of every element's blocks through memory.
-void scatter_hessians(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
-  Solver::Scratch& s = c.s;
-  const auto& row_start = c.model.block_start();
-  for (const std::int32_t v : s.active_list_)
-    for (std::int32_t j = row_start[std::size_t(v)]; j < row_start[std::size_t(v) + 1]; ++j)
-      s.blocks_[std::size_t(j)].setZero();
-  Eigen::Matrix3d upper[6];
-  for (std::int64_t e = 0; e < c.ne; ++e) {
-    if (s.changed_slot_[std::size_t(e)] < 0) continue;
-    detail::ElementState state = state_at(c, e, x);
-    detail::add_hessian_terms(state);
-    detail::hessian_upper_blocks(c.model.elements()[std::size_t(e)], state, c.model.lambda(),
-                                 c.model.mu(), upper);
-    const mesh::Face& f = c.model.element_faces()[std::size_t(e)];
-    for (int a = 0; a < 3; ++a)
-      if (s.active_[std::size_t(f[std::size_t(a)])]) add_element_row(c, e, a, upper);
-  }
-  for (const std::int32_t v : s.active_list_) finish_diagonal(c, v);
-}
-
-// Phase 5b: the Hessian approximation's 3 x 3 blocks of the active rows, with the nodal
-// attachment and inertia terms on the diagonal, and the diagonal blocks' inverses (both
-// preconditioners use them). Blocks of inactive rows are neither written nor read.
-void assemble(Context& c, const Eigen::Ref<const Eigen::Matrix3Xd>& x) {
-  Solver::Scratch& s = c.s;
-  s.blocks_.resize(c.model.block_column().size());
-  s.block_inverse_.resize(static_cast<std::size_t>(c.nv));
-  if (c.parallel())
-    gather_hessians(c, x);
-  else
-    scatter_hessians(c, x);
-}
-
-// out = H d over the active rows and columns (only active rows of out are written).
-void hessian_apply(Context& c, const Eigen::Matrix3Xd& d, Eigen::Matrix3Xd& out) {
-  const auto& start = c.model.block_start();
-  const auto& column = c.model.block_column();
-  const auto& list = c.s.active_list_;
-  const auto na = static_cast<std::int64_t>(list.size());
-#pragma omp parallel for schedule(static) num_threads(c.threads) if (c.parallel())
-  for (std::int64_t i = 0; i < na; ++i) {
-    const auto v = std::size_t(list[std::size_t(i)]);
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (std::int32_t j = start[v]; j < start[v + 1]; ++j) {
-      const std::int32_t u = column[std::size_t(j)];
-      if (c.s.active_[std::size_t(u)]) sum.noalias() += c.s.blocks_[std::size_t(j)] * d.col(u);
-    }
-    out.col(std::int64_t(v)) = sum;
-  }
-}
-
-// Phase 6: H step = -g over the active nodes by preconditioned conjugate gradients, on the
-// active columns only; returns the iterations.
-int jacobi_cg(Context& c) {
-  Solver::Scratch& s = c.s;
-  const auto& list = s.active_list_;
-  double rz = 0, rr = 0;
-  for (const std::int32_t v : list) {
-    s.step_.col(v).setZero();
-    s.r_.col(v) = -s.gradient_.col(v);
-    s.z_.col(v) = s.block_inverse_[std::size_t(v)] * s.r_.col(v);
-    s.p_.col(v) = s.z_.col(v);
-    rz += s.r_.col(v).dot(s.z_.col(v));
-    rr += s.r_.col(v).squaredNorm();
-  }
-  const double stop = c.settings.cg_relative_tolerance * std::sqrt(rr);
-  int it = 0;
-  while (it < c.settings.max_cg_iterations && std::sqrt(rr) > stop) {
-    hessian_apply(c, s.p_, s.q_);
-    double pq = 0;
-    for (const std::int32_t v : list) pq += s.p_.col(v).dot(s.q_.col(v));
-    if (!(pq > 0)) break;  // no curvature left along p (cannot happen with a PSD H unless p = 0)
-    const double alpha = rz / pq;
-    double rz_next = 0;
-    rr = 0;
-    for (const std::int32_t v : list) {
-      s.step_.col(v) += alpha * s.p_.col(v);
-      s.r_.col(v) -= alpha * s.q_.col(v);
-      s.z_.col(v) = s.block_inverse_[std::size_t(v)] * s.r_.col(v);
-      rz_next += s.r_.col(v).dot(s.z_.col(v));
-      rr += s.r_.col(v).squaredNorm();
-    }
-    const double beta = rz_next / rz;
-    for (const std::int32_t v : list) s.p_.col(v) = s.z_.col(v) + beta * s.p_.col(v);
-    rz = rz_next;
-    ++it;
-  }
-  return it;
-}
-
-// With H = l + l^T - D (l = D + L, L the strictly lower blocks in vertex order, over the active
-// rows and columns): out = l^-1 rhs (forward) or l^-T rhs (backward) by block substitution.
-void lower_solve(Context& c, const Eigen::Matrix3Xd& rhs, Eigen::Matrix3Xd& out, bool forward) {
-  Solver::Scratch& s = c.s;
-  const auto& start = c.model.block_start();
-  const auto& column = c.model.block_column();
-  const auto& diagonal = c.model.diagonal_block();
-  const auto n = static_cast<std::int64_t>(s.active_list_.size());
-  for (std::int64_t i = 0; i < n; ++i) {
-    const auto v = std::size_t(s.active_list_[std::size_t(forward ? i : n - 1 - i)]);
-    Eigen::Vector3d sum = rhs.col(std::int64_t(v));
-    const std::int32_t first = forward ? start[v] : diagonal[v] + 1;
-    const std::int32_t last = forward ? diagonal[v] : start[v + 1];
-    for (std::int32_t j = first; j < last; ++j) {
-      const std::int32_t u = column[std::size_t(j)];
-      if (s.active_[std::size_t(u)]) sum.noalias() -= s.blocks_[std::size_t(j)] * out.col(u);
-    }
-    out.col(std::int64_t(v)) = s.block_inverse_[v] * sum;
-  }
-}
-
-// Symmetric Gauss-Seidel preconditioned CG by Eisenstat's trick: CG on the SPD system
-// l^-1 H l^-T y = l^-1 b (b = -g, step = l^-T y) with the preconditioner D, where
-//   l^-1 H l^-T p = t + l^-1 (p - D t),  t = l^-T p,
-// costs one forward and one backward sweep (together one multiplication by H). The stopping
-// test is on the transformed residual, relative to its start.
-int gauss_seidel_cg(Context& c) {
-  Solver::Scratch& s = c.s;
-  const auto& list = s.active_list_;
-  const auto& diagonal = c.model.diagonal_block();
-  const auto d = [&](std::int32_t v) -> const Eigen::Matrix3d& {
-    return s.blocks_[std::size_t(diagonal[std::size_t(v)])];
-  };
-  for (const std::int32_t v : list) s.q_.col(v) = -s.gradient_.col(v);
-  lower_solve(c, s.q_, s.r_, true);  // r = l^-1 b
-  double rz = 0;
-  for (const std::int32_t v : list) {
-    s.step_.col(v).setZero();  // y
-    s.z_.col(v) = d(v) * s.r_.col(v);
-    s.p_.col(v) = s.z_.col(v);
-    rz += s.r_.col(v).dot(s.z_.col(v));
-  }
-  const double stop = c.settings.cg_relative_tolerance * std::sqrt(rz);
-  int it = 0;
-  while (it < c.settings.max_cg_iterations && std::sqrt(rz) > stop) {
-    lower_solve(c, s.p_, s.trial_direction_, false);  // t = l^-T p
-    for (const std::int32_t v : list) s.q_.col(v) = s.p_.col(v) - d(v) * s.trial_direction_.col(v);
-    lower_solve(c, s.q_, s.q_, true);  // in place: row v reads only rows before it
-    double pq = 0;
-    for (const std::int32_t v : list) {
-      s.q_.col(v) += s.trial_direction_.col(v);
-      pq += s.p_.col(v).dot(s.q_.col(v));
-    }
-    if (!(pq > 0)) break;
-    const double alpha = rz / pq;
-    double rz_next = 0;
-    for (const std::int32_t v : list) {
-      s.step_.col(v) += alpha * s.p_.col(v);
-      s.r_.col(v) -= alpha * s.q_.col(v);
-      s.z_.col(v) = d(v) * s.r_.col(v);
-      rz_next += s.r_.col(v).dot(s.z_.col(v));
-    }
-    const double beta = rz_next / rz;
-    for (const std::int32_t v : list) s.p_.col(v) = s.z_.col(v) + beta * s.p_.col(v);
-    rz = rz_next;
-    ++it;
-  }
-  for (const std::int32_t v : list) s.q_.col(v) = s.step_.col(v);
-  lower_solve(c, s.q_, s.step_, false);  // step = l^-T y
-  return it;
-}
-
-// gauss_seidel_cg on the packed active system (active_system.hpp): the same step.
-int packed_gauss_seidel_cg(Context& c) {
-  Solver::Scratch& s = c.s;
-  const auto& list = s.active_list_;
-  s.system_.pack({c.model.block_start(), c.model.block_column(), c.model.diagonal_block(),
-                  s.blocks_, s.block_inverse_, list, s.active_});
-  const auto na = static_cast<Eigen::Index>(list.size());
-  s.packed_rhs_.resize(3, na);
-  for (Eigen::Index i = 0; i < na; ++i) s.packed_rhs_.col(i) = -s.gradient_.col(list[std::size_t(i)]);
-  const int it = s.system_.gauss_seidel_cg(s.packed_rhs_, c.settings.cg_relative_tolerance,
-                                           c.settings.max_cg_iterations, s.packed_step_);
-  for (Eigen::Index i = 0; i < na; ++i) s.step_.col(list[std::size_t(i)]) = s.packed_step_.col(i);
-  return it;
-}
-
-int conjugate_gradients(Context& c) {
-  Solver::Scratch& s = c.s;
-  if (c.settings.preconditioner == Preconditioner::symmetric_gauss_seidel &&
-      c.settings.packed_systems) {
-    s.step_.resize(3, c.nv);
-    return packed_gauss_seidel_cg(c);
-  }
-  for (auto* m : {&s.step_, &s.r_, &s.z_, &s.p_, &s.q_, &s.trial_direction_}) m->resize(3, c.nv);
-  return c.settings.preconditioner == Preconditioner::block_jacobi ? jacobi_cg(c)
-                                                                   : gauss_seidel_cg(c);
-}
-
 // Phi(x + alpha step) - Phi(x): only the changed elements and the active nodes' own terms
 // differ, so the difference is summed over them (cheap, and free of the cancellation that
 // comparing two totals of the whole mesh suffers near the solution). The trial elements'
@@ -659,9 +345,11 @@ bool line_search(Context& c, Eigen::Ref<Eigen::Matrix3Xd> x) {
 }
 
 }  // namespace
+}  // namespace solver_detail
 
 SolveReport Solver::solve(const Model& model, const StepInput& input,
                           const SolverSettings& settings, Eigen::Ref<Eigen::Matrix3Xd> x) {
+  using namespace solver_detail;
   settings.validate();
   const Eigen::Index nv = model.vertex_count();
   require_cols(x, nv, false, "x");
@@ -705,7 +393,7 @@ SolveReport Solver::solve(const Model& model, const StepInput& input,
     select_active(c, report.residual, x);
     mark_changed(c);
     assemble(c, x);
-    report.cg_iterations += conjugate_gradients(c);
+    report.cg_iterations += solve_newton_system(c);
     if (!line_search(c, x)) break;
   }
   s.last_x_ = x;  // forces_ are of x's elements (line_search keeps them so)
