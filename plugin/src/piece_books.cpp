@@ -10,10 +10,6 @@
 
 namespace conform::bullet {
 
-SkinnedSoftBody::Impl::PieceBody::~PieceBody() {
-  if (owner) owner->body_deleted_by_app(slot);
-}
-
 SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece(std::int32_t parent) {
   const auto slot = std::int32_t(pieces_.size());
   const Piece* from = parent >= 0 && pieces_[static_cast<std::size_t>(parent)] &&
@@ -22,19 +18,16 @@ SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece(std::int32_t pare
                           : nullptr;
   auto piece = std::make_unique<Piece>();
   // This constructor (unlike the world-info-only one) creates the default material.
-  piece->body = std::make_unique<PieceBody>(info_, this, slot);
+  piece->body = std::make_unique<PieceBody>(info_, &pieces_, slot);
   piece->settings = from ? from->settings : defaults_;
   piece->released = from && from->released;
   if (from) piece->release = from->release;
   btSoftBody& body = *piece->body;
   configure_body(body, from);
   link_.add(&body, piece->settings.collision_group, piece->settings.collision_mask);
-  pieces_.push_back(std::move(piece));
-  generation_.push_back(1);
-  events_.push_back(
-      {PieceEvent::Kind::created, id_of_slot(slot), from ? id_of_slot(parent) : PieceId{}});
+  Piece& added = pieces_.add(std::move(piece), from ? parent : -1);
   ++stats_.new_pieces;
-  return *pieces_.back();
+  return added;
 }
 
 void SkinnedSoftBody::Impl::configure_body(btSoftBody& body, const Piece* from) {
@@ -186,12 +179,10 @@ void SkinnedSoftBody::Impl::place_faces_and_links(const mesh::SkinnedMesh& m) {
 void SkinnedSoftBody::Impl::drop_empty_pieces() {
   // Pieces left without nodes leave the world.
   for (std::size_t slot = 0; slot < pieces_.size(); ++slot) {
-    auto& piece = pieces_[slot];
+    const auto& piece = pieces_[slot];
     if (!piece || !piece->body || piece->body->m_nodes.size() != 0) continue;
-    events_.push_back({PieceEvent::Kind::removed, id_of_slot(std::int32_t(slot)), {}});
     link_.remove(piece->body.get());
-    piece.reset();
-    ++generation_[slot];  // every id of it is stale from now on
+    pieces_.remove(std::int32_t(slot));
   }
 }
 

@@ -33,46 +33,6 @@ inline std::int32_t third_vertex(const mesh::Face& f, std::int32_t a, std::int32
   return -1;
 }
 
-/// A piece's btSoftBody. It tells the books when the application deletes it (Bullet's standard
-/// teardown deletes every soft body of the world), so that the plugin neither deletes nor
-/// touches it again. `owner` is null when the plugin deletes it itself.
-struct SkinnedSoftBody::Impl::PieceBody final : btSoftBody {
-  PieceBody(btSoftBodyWorldInfo* info, Impl* books, std::int32_t piece_slot)
-      : btSoftBody(info, 0, nullptr, nullptr), owner(books), slot(piece_slot) {}
-  ~PieceBody() override;  // piece_books.cpp
-  PieceBody(const PieceBody&) = delete;
-  PieceBody& operator=(const PieceBody&) = delete;
-  Impl* owner;
-  std::int32_t slot;
-};
-
-struct SkinnedSoftBody::Impl::Piece {
-  Piece() = default;
-  Piece(const Piece&) = delete;
-  Piece& operator=(const Piece&) = delete;
-  ~Piece() {
-    if (body) body->owner = nullptr;  // deleted by the plugin: no notice
-  }
-  // Memory the body's node, face and link arrays start in (see move_to_new_piece); declared
-  // first, so it outlives the body (which never frees memory it does not own).
-  struct Release {
-    void operator()(std::byte* p) const { ::operator delete[](p, std::align_val_t{16}); }
-  };
-  std::unique_ptr<std::byte[], Release> storage;
-  std::unique_ptr<PieceBody> body;        // null once the application deleted it
-  std::vector<std::int32_t> node_vertex;  // node index → mesh vertex
-  std::vector<double> rest;               // link index → our rest length (Bullet resets its own)
-  std::vector<std::pair<std::int32_t, std::int32_t>> link_key;  // link → its key edge (min, max)
-  std::vector<std::uint8_t> link_bend;                          // link → 1 for a bending link
-  std::vector<std::int32_t> face_id;                            // Bullet face slot → mesh face
-  std::int32_t bending = 0;                                     // bending links in this body
-  bool reapply = true;        // rest lengths to write at the next update (set when built)
-  PieceSettings settings;     // inherited by the pieces split from it
-  bool released = false;      // released from skinning (release_piece): not driven
-  ReleaseOptions release{};   // how, when released
-  double release_volume = 0;  // V0, m³: the closed piece's volume at release (0: open)
-};
-
 /// One whole connected piece on its way into a new body (move_to_new_piece and its steps).
 struct SkinnedSoftBody::Impl::PieceMove {
   std::span<const std::int32_t> moving;  // its vertices; node i of the new body is moving[i]
@@ -91,7 +51,7 @@ inline btSoftBody* SkinnedSoftBody::Impl::body_of(std::int32_t v) const {
 // The node of an attached vertex (its body deleted by the application: refused).
 inline const btSoftBody::Node& SkinnedSoftBody::Impl::node(std::int32_t v) const {
   const btSoftBody* body = body_of(v);
-  if (!body) throw std::logic_error("SkinnedSoftBody: " + lost_);
+  if (!body) throw std::logic_error("SkinnedSoftBody: " + pieces_.lost());
   return body->m_nodes[node_of_[static_cast<std::size_t>(v)]];
 }
 

@@ -131,7 +131,8 @@ void SkinDrive::advance(const mesh::SkinnedMesh& mesh, double time) {
 // --- The per-substep drive ---
 
 void SkinnedSoftBody::Impl::update(double dt, double time) {
-  if (!lost_.empty()) throw std::logic_error("SkinnedSoftBody: cannot step: " + lost_);
+  if (!pieces_.lost().empty())
+    throw std::logic_error("SkinnedSoftBody: cannot step: " + pieces_.lost());
   if (!(dt > 0)) return;
   time_ = time;
   if (!started_) {

@@ -6,7 +6,7 @@
 //   bullet_surgery.cpp     add/remove of nodes, faces and links, link constants, node areas;
 //   piece_books.cpp        bodies per piece, moving a piece, detaching, kept rest lengths;
 //   topology_mirror.cpp    a TopologyChange into Bullet, in phases over a MirrorContext;
-//   piece_handles.cpp      piece ids, events, per-piece settings, the edit guard;
+//   piece_handles.*        the pieces: slots, ids, events, per-piece settings (a part);
 //   piece_release.cpp      releasing a piece from skinning (a free Bullet soft body).
 #pragma once
 
@@ -27,6 +27,7 @@
 #include "conform/mesh/face_index.hpp"
 #include "conform/mesh/split_search.hpp"
 #include "membrane_drive.hpp"
+#include "piece_handles.hpp"
 #include "skin_drive.hpp"
 #include "tear_growth.hpp"
 
@@ -111,28 +112,14 @@ struct SkinnedSoftBody::Impl {
   std::int32_t detached_count() const { return detached_count_; }
   bool is_kinematic_by_weight(std::int32_t vertex) const;
 
-  // --- Piece handles, events, settings, edit guard (piece_handles.cpp) ---
-  std::vector<PieceId> piece_ids() const;
-  bool piece_valid(PieceId id) const;
-  btSoftBody* piece_body(PieceId id) const;
+  // --- Pieces (ids, events, per-piece settings: pieces_, piece_handles.hpp) ---
+  using Piece = bullet::Piece;
+  using PieceBody = bullet::PieceBody;
   PieceId piece_of(std::int32_t vertex) const;
-  PieceId id_of_slot(std::int32_t slot) const;
-  void on_piece_event(std::function<void(const PieceEvent&)> listener);
-  const PieceSettings& piece_settings(PieceId id) const;
-  void set_piece_user(PieceId id, void* user);
   void set_piece_collision(PieceId id, int group, int mask);
-  bool piece_released(PieceId id) const;
-  struct Piece;      // piece_books.hpp
-  struct PieceBody;  // piece_books.hpp
-  /// The live piece `id` names; throws std::invalid_argument naming `what` when stale.
-  Piece& live_piece(PieceId id, const char* what) const;
   /// Throws std::logic_error when an edit named `what` may not run now: inside a step, or
   /// after the application deleted a piece's body.
   void check_editable(const char* what) const;
-  /// Hands the events queued by the last edit to the listeners.
-  void deliver_events();
-  /// Called by a PieceBody the application deletes.
-  void body_deleted_by_app(std::int32_t slot);
   // --- Render data (render_data.cpp) ---
   Eigen::Matrix3Xd normals() const;
   std::vector<skin::Versor> joint_transforms() const;
@@ -280,13 +267,9 @@ struct SkinnedSoftBody::Impl {
   // Edges whose bending link may have to be made again at the end of a change.
   std::vector<std::pair<std::int32_t, std::int32_t>> bend_dirty_;
 
-  std::vector<std::unique_ptr<Piece>> pieces_;  // null once emptied
-  std::vector<std::uint32_t> generation_;       // per slot; changes when its piece is removed
-  std::vector<std::function<void(const PieceEvent&)>> listeners_;
-  std::vector<PieceEvent> events_;      // queued during an edit, delivered after it
-  std::string lost_;                    // why the body is unusable (a piece deleted by the app)
-  double time_ = 0;                     // of the last substep (targets after an edit)
-  std::uint64_t topology_version_ = 0;  // changes mirrored
+  PieceHandles pieces_;
+  double time_ = 0;                           // of the last substep (targets after an edit)
+  std::uint64_t topology_version_ = 0;        // changes mirrored
   std::optional<mesh::ScalpelSample> blade_;  // the last tear sample (debug drawing)
   std::optional<Clock> clock_;                // the body's own animation clock, when set
   double clock_now_ = 0;                      // the time the pose source was last sampled at
