@@ -78,7 +78,7 @@ void SkinnedSoftBody::Impl::build(const mesh::SkinnedMesh& m) {
   const auto n = static_cast<std::size_t>(m.vertex_count());
   area_mark_.assign(n, 0);
   seed_mark_.assign(n, 0);
-  clear_kept();
+  kept_.clear();
   bend_dirty_.clear();
   stats_ = {};
 }
@@ -197,29 +197,6 @@ void SkinnedSoftBody::Impl::detach(std::int32_t v) {
   ++stats_.detached_nodes;
 }
 
-void SkinnedSoftBody::Impl::keep_rest(std::int32_t a, std::int32_t b, std::int32_t c,
-                                      std::int32_t d, double rest, bool bending) {
-  (bending ? relink_bend_ : relink_edge_).insert(a, b, std::int32_t(relink_.size()), true);
-  relink_.emplace_back(a, b, c, d, rest);
-}
-
-double SkinnedSoftBody::Impl::kept_rest(std::int32_t a, std::int32_t b, std::int32_t c,
-                                        std::int32_t d, bool bending) const {
-  const std::int32_t i = (bending ? relink_bend_ : relink_edge_).find(a, b);
-  if (i < 0) return -1;
-  const auto& [ka, kb, kc, kd, rest] = relink_[static_cast<std::size_t>(i)];
-  return kc == c && kd == d ? rest : -1;
-}
-
-void SkinnedSoftBody::Impl::clear_kept() {
-  for (std::size_t i = 0; i < relink_.size(); ++i) {
-    const auto& [a, b, c, d, rest] = relink_[i];
-    const bool bending = !(a == c && b == d);
-    (bending ? relink_bend_ : relink_edge_).erase(a, b, std::int32_t(i));
-  }
-  relink_.clear();
-}
-
 void SkinnedSoftBody::Impl::refresh_bending(std::int32_t a, std::int32_t b) {
   // A bending link across (a, b) iff exactly two faces use the edge, both in the same body;
   // it joins their third vertices. A link of the same vertices removed earlier in this change
@@ -239,7 +216,7 @@ void SkinnedSoftBody::Impl::refresh_bending(std::int32_t a, std::int32_t b) {
   const std::int32_t c = third_vertex(faces_[static_cast<std::size_t>(found[0])], a, b),
                      d = third_vertex(faces_[static_cast<std::size_t>(found[1])], a, b);
   if (c < 0 || d < 0 || c == d) return;
-  double rest = kept_rest(a, b, std::min(c, d), std::max(c, d), true);
+  double rest = kept_.find(a, b, std::min(c, d), std::max(c, d), true);
   if (rest < 0) rest = (1 - material_.pretension) * (position(c) - position(d)).norm();
   add_bending(p, a, b, c, d, rest);
 }

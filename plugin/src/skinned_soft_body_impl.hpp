@@ -26,6 +26,7 @@
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/face_index.hpp"
 #include "conform/mesh/split_search.hpp"
+#include "kept_rest.hpp"
 #include "membrane_drive.hpp"
 #include "piece_handles.hpp"
 #include "skin_drive.hpp"
@@ -168,12 +169,6 @@ struct SkinnedSoftBody::Impl {
   void move_faces(PieceMove& move);
   void move_links(PieceMove& move);
   std::vector<btDbvtNode*> leave_old_bodies(PieceMove& move);
-  // Links removed during one change whose link may come back keep their rest length.
-  void keep_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d, double rest,
-                 bool bending);
-  double kept_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
-                   bool bending) const;
-  void clear_kept();
   void refresh_bending(std::int32_t a, std::int32_t b);
 
   // --- Bullet surgery (bullet_surgery.cpp) ---
@@ -259,10 +254,7 @@ struct SkinnedSoftBody::Impl {
   // The split search of a change (its per-vertex labels stay allocated between changes).
   mesh::SplitSearch split_;
   std::vector<std::int32_t> move_slot_;  // per vertex: its node in a new body (−1 between)
-  // Links removed during one change whose link may come back: (a, b, c, d, rest), where (a, b)
-  // is the key edge and (c, d) the end vertices (equal to (a, b) for an edge link).
-  std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, double>> relink_;
-  mesh::EdgeMap relink_edge_, relink_bend_;          // key edge → index in relink_
+  KeptRest kept_;  // rest lengths of the links a change removed that may come back
   std::vector<std::uint8_t> area_mark_, seed_mark_;  // per vertex scratch, 0 between changes
   // Edges whose bending link may have to be made again at the end of a change.
   std::vector<std::pair<std::int32_t, std::int32_t>> bend_dirty_;

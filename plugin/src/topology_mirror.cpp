@@ -36,7 +36,7 @@ void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
   if (mesh_.vertex_count() < v0 + std::int32_t(change.new_vertices.size()))
     throw std::logic_error("SkinnedSoftBody: mesh lacks the change's new vertices");
   MirrorContext c(change, v0, material_.bending_stiffness > 0, stats_.seconds, start);
-  clear_kept();
+  kept_.clear();
   bend_dirty_.clear();
   make_new_vertices(c);
   c.seconds.vertices += seconds_since(c.clock);
@@ -53,7 +53,7 @@ void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
   refresh_changed_areas(c);
   drop_empty_pieces();
   refresh_released();
-  clear_kept();
+  kept_.clear();
   bend_dirty_.clear();
   split_.clear();
   c.seconds.insert += seconds_since(c.clock);
@@ -133,7 +133,7 @@ void SkinnedSoftBody::Impl::remove_faces(MirrorContext& c) {
     const std::int32_t li = edge_link_.find(a, b);
     if (li < 0) continue;
     const std::int32_t p = piece_of_[static_cast<std::size_t>(a)];
-    keep_rest(a, b, a, b, pieces_[static_cast<std::size_t>(p)]->rest[std::size_t(li)], false);
+    kept_.keep(a, b, a, b, pieces_[static_cast<std::size_t>(p)]->rest[std::size_t(li)], false);
     remove_link(p, li);
   }
 }
@@ -362,7 +362,7 @@ void SkinnedSoftBody::Impl::insert_faces_and_links(MirrorContext& c) {
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
       if (c.bending) bend_dirty_.emplace_back(a, b);
       if (!(c.new_edges[i] >> k & 1u)) continue;  // it has its link
-      const double kept = kept_rest(a, b, a, b, false);
+      const double kept = kept_.find(a, b, a, b, false);
       if (kept >= 0) {
         add_link(p, a, b, kept);
         --stats_.added_links;
