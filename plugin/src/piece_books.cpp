@@ -89,7 +89,8 @@ void SkinnedSoftBody::Impl::reserve_books(const mesh::SkinnedMesh& m) {
   const auto n = static_cast<std::size_t>(m.vertex_count());
   split_.reserve(std::int32_t(2 * n));
   split_.begin(std::int32_t(n));
-  for (auto* table : {&piece_of_, &node_of_, &detached_slot_, &move_slot_}) table->reserve(2 * n);
+  for (auto* table : {&piece_of_, &node_of_, &move_slot_}) table->reserve(2 * n);
+  detached_.reserve(2 * n);
   for (auto* table : {&area_mark_, &seed_mark_, &pinned_, &kinematic_}) table->reserve(2 * n);
   mass_.reserve(2 * n);
   vertex_faces_.reserve(2 * n);
@@ -108,7 +109,7 @@ void SkinnedSoftBody::Impl::index_faces(const mesh::SkinnedMesh& m) {
   vertex_faces_.assign(n, {});
   piece_of_.assign(n, -1);
   node_of_.assign(n, -1);
-  detached_slot_.assign(n, -1);
+  detached_.reset(n);
   for (std::size_t f = 0; f < faces_.size(); ++f) {
     for (const auto v : faces_[f])
       vertex_faces_[static_cast<std::size_t>(v)].push_back(std::int32_t(f));
@@ -149,10 +150,7 @@ void SkinnedSoftBody::Impl::place_nodes(const mesh::SkinnedMesh& m, const mesh::
   for (std::int32_t v = 0; v < m.vertex_count(); ++v) {
     const auto& vf = vertex_faces_[static_cast<std::size_t>(v)];
     if (vf.empty()) {  // no faces: not a node (its mass stays in the books)
-      detached_slot_[static_cast<std::size_t>(v)] = std::int32_t(detached_state_.size());
-      detached_state_.emplace_back(m.current.col(v), Eigen::Vector3d::Zero());
-      detached_vertex_.push_back(v);
-      ++detached_count_;
+      detached_.add(v, m.current.col(v), Eigen::Vector3d::Zero());
       continue;
     }
     add_node(
@@ -190,10 +188,7 @@ void SkinnedSoftBody::Impl::detach(std::int32_t v) {
   const auto i = static_cast<std::size_t>(v);
   const Eigen::Vector3d x = position(v), vel = velocity(v);
   remove_node(v);
-  detached_slot_[i] = std::int32_t(detached_state_.size());
-  detached_state_.emplace_back(x, vel);
-  detached_vertex_.push_back(v);
-  ++detached_count_;
+  detached_.add(v, x, vel);
   ++stats_.detached_nodes;
 }
 

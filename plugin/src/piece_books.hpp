@@ -57,13 +57,13 @@ inline const btSoftBody::Node& SkinnedSoftBody::Impl::node(std::int32_t v) const
 
 inline Eigen::Vector3d SkinnedSoftBody::Impl::position(std::int32_t v) const {
   const auto i = static_cast<std::size_t>(v);
-  if (piece_of_[i] < 0) return detached_state_[static_cast<std::size_t>(detached_slot_[i])].first;
+  if (piece_of_[i] < 0) return detached_.position(v);
   return from_bt(node(v).m_x);
 }
 
 inline Eigen::Vector3d SkinnedSoftBody::Impl::velocity(std::int32_t v) const {
   const auto i = static_cast<std::size_t>(v);
-  if (piece_of_[i] < 0) return detached_state_[static_cast<std::size_t>(detached_slot_[i])].second;
+  if (piece_of_[i] < 0) return detached_.velocity(v);
   return from_bt(node(v).m_v);
 }
 

@@ -150,11 +150,11 @@ void SkinnedSoftBody::Impl::update(double dt, double time) {
     clock_now_ = time;
   }
   drive_.advance(mesh_, clock_now_);
-  for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot) {
+  for (std::int32_t slot = 0; slot < detached_.count(); ++slot) {
     // A detached vertex rides its target.
-    const auto v = static_cast<std::size_t>(detached_vertex_[slot]);
+    const auto v = static_cast<std::size_t>(detached_.vertex(slot));
     const Eigen::Vector3d t = drive_.target(std::int32_t(v)), tp = drive_.previous_target(v);
-    detached_state_[slot] = {t, (t - tp) / dt};
+    detached_.set(slot, t, (t - tp) / dt);
   }
   hold_released_volumes(dt);
   if (membrane_model()) {
@@ -268,8 +268,8 @@ void SkinnedSoftBody::Impl::place_on_pose() {
     }
     refit_tree(body.m_ndbvt.m_root);  // the leaves moved: their ancestors follow
   }
-  for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot)
-    detached_state_[slot] = {drive_.target(detached_vertex_[slot]), Eigen::Vector3d::Zero()};
+  for (std::int32_t slot = 0; slot < detached_.count(); ++slot)
+    detached_.set(slot, drive_.target(detached_.vertex(slot)), Eigen::Vector3d::Zero());
   membrane_.invalidate();  // its carried solution is of the old positions
 }
 

@@ -26,6 +26,7 @@
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/face_index.hpp"
 #include "conform/mesh/split_search.hpp"
+#include "detached_vertices.hpp"
 #include "kept_rest.hpp"
 #include "membrane_drive.hpp"
 #include "piece_handles.hpp"
@@ -110,7 +111,7 @@ struct SkinnedSoftBody::Impl {
   bool detached(std::int32_t vertex) const {
     return piece_of_[static_cast<std::size_t>(vertex)] < 0;
   }
-  std::int32_t detached_count() const { return detached_count_; }
+  std::int32_t detached_count() const { return detached_.count(); }
   bool is_kinematic_by_weight(std::int32_t vertex) const;
 
   // --- Pieces (ids, events, per-piece settings: pieces_, piece_handles.hpp) ---
@@ -247,10 +248,7 @@ struct SkinnedSoftBody::Impl {
   // Per undirected edge (min, max) crossed by a bending link: its link index in its piece.
   mesh::EdgeMap bend_link_;
   // Detached vertices: their position and velocity when they left Bullet.
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> detached_state_;
-  std::vector<std::int32_t> detached_slot_;    // per vertex, −1 unless detached
-  std::vector<std::int32_t> detached_vertex_;  // per slot
-  std::int32_t detached_count_ = 0;
+  DetachedVertices detached_;
   // The split search of a change (its per-vertex labels stay allocated between changes).
   mesh::SplitSearch split_;
   std::vector<std::int32_t> move_slot_;  // per vertex: its node in a new body (−1 between)

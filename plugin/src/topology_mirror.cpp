@@ -64,7 +64,7 @@ void SkinnedSoftBody::Impl::make_new_vertices(MirrorContext& c) {
   // proportion to the same coefficients, so Σm and Σm·v are unchanged exactly.
   piece_of_.resize(c.total, -1);
   node_of_.resize(c.total, -1);
-  detached_slot_.resize(c.total, -1);
+  detached_.grow(c.total);
   mass_.resize(c.total, 0);
   pinned_.resize(c.total, 0);
   kinematic_.resize(c.total, 0);
@@ -306,11 +306,7 @@ void SkinnedSoftBody::Impl::place_changed_nodes(MirrorContext& c) {
     const std::int32_t id = c.v0 + i;
     const std::int32_t group = split_.group_of(id);
     if (group == mesh::SplitSearch::kUnreached) {
-      detached_slot_[static_cast<std::size_t>(id)] = std::int32_t(detached_state_.size());
-      detached_state_.emplace_back(c.x[static_cast<std::size_t>(i)],
-                                   c.v[static_cast<std::size_t>(i)]);
-      detached_vertex_.push_back(id);
-      ++detached_count_;
+      detached_.add(id, c.x[static_cast<std::size_t>(i)], c.v[static_cast<std::size_t>(i)]);
       ++stats_.detached_nodes;
       continue;
     }
