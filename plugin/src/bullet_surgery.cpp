@@ -8,7 +8,8 @@
 #include <cstring>
 #include <new>
 
-#include "piece_books.hpp"
+#include "edge_key.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 

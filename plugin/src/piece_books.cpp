@@ -1,14 +1,25 @@
 // The piece books: making the bodies (one per connected piece), moving a whole piece into a
-// new body, detaching a vertex, and the link rest lengths and bending links kept through a
-// change.
-#include "piece_books.hpp"
-
+// new body, detaching a vertex, and the bending links made again after a change.
 #include <algorithm>
+#include <new>
+#include <span>
 
 #include "bullet_surgery.hpp"
 #include "conform/mesh/analysis.hpp"
+#include "edge_key.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
+
+/// One whole connected piece on its way into a new body (move_to_new_piece and its steps).
+struct SkinnedSoftBody::Impl::PieceMove {
+  std::span<const std::int32_t> moving;  // its vertices; node i of the new body is moving[i]
+  std::vector<std::int32_t> sources;     // bodies the nodes leave (normally one)
+  std::vector<std::int32_t> faces;       // mesh faces, each once
+  std::vector<std::vector<std::uint8_t>> marks;  // per source body: per link, 1 if it moves
+  std::size_t link_count = 0;                    // links marked
+  std::int32_t into = -1;                        // the new body's index
+};
 
 SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece(std::int32_t parent) {
   const auto slot = std::int32_t(pieces_.size());

@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "bullet_surgery.hpp"
-#include "piece_books.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 

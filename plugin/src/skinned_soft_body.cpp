@@ -9,9 +9,10 @@
 #include <string>
 
 #include "conform/skin/limb_axes.hpp"
+#include "edge_key.hpp"
 #include "material_fit.hpp"
 #include "phase_clock.hpp"
-#include "piece_books.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 

@@ -1,14 +1,18 @@
 // SkinnedSoftBody's private side: the books mirroring the mesh into Bullet (per vertex, per
 // face, per edge), the skin drive and the scratch of topology changes. The public class
-// forwards to it (skinned_soft_body.hpp describes the behaviour). Its members live by concept:
+// forwards to it (skinned_soft_body.hpp describes the behaviour). Parts that own their state
+// (each header states its invariant): PieceHandles (piece_handles.hpp), KeptRest
+// (kept_rest.hpp), DetachedVertices (detached_vertices.hpp), SkinDrive, MembraneDrive,
+// TearGrowth. Its own members live by concept:
 //   skinned_soft_body.cpp  facade: construction, edit entry points, queries, forwarders;
 //   skin_drive.cpp         pose source, skinned targets, the per-substep update;
 //   bullet_surgery.cpp     add/remove of nodes, faces and links, link constants, node areas;
-//   piece_books.cpp        bodies per piece, moving a piece, detaching, kept rest lengths;
+//   piece_books.cpp        bodies per piece, moving a piece, detaching, bending links;
 //   topology_mirror.cpp    a TopologyChange into Bullet, in phases over a MirrorContext;
-//   piece_handles.*        the pieces: slots, ids, events, per-piece settings (a part);
 //   piece_release.cpp      releasing a piece from skinning (a free Bullet soft body).
 #pragma once
+
+#include <BulletSoftBody/btSoftBody.h>
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -16,11 +20,13 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
+#include "conform/bullet/convert.hpp"
 #include "conform/bullet/skinned_soft_body.hpp"
 #include "conform/mesh/adjacency.hpp"
 #include "conform/mesh/analysis.hpp"
@@ -90,7 +96,7 @@ struct SkinnedSoftBody::Impl {
   std::int32_t vertex_count() const { return mesh_.vertex_count(); }
   std::int32_t piece_count() const;
   std::vector<btSoftBody*> pieces() const;
-  inline Eigen::Vector3d position(std::int32_t vertex) const;  // piece_books.hpp
+  inline Eigen::Vector3d position(std::int32_t vertex) const;  // below
   inline Eigen::Vector3d velocity(std::int32_t vertex) const;
   double mass(std::int32_t vertex) const { return mass_[static_cast<std::size_t>(vertex)]; }
   bool kinematic(std::int32_t vertex) const { return kinematic_[static_cast<std::size_t>(vertex)]; }
@@ -146,7 +152,7 @@ struct SkinnedSoftBody::Impl {
   void reapply_rest_lengths(Piece& piece);
 
   // --- Piece books (piece_books.cpp) ---
-  struct PieceMove;  // piece_books.hpp
+  struct PieceMove;  // piece_books.cpp
   /// A new, empty piece in the world; its settings from `parent` (a slot; −1: the defaults).
   Piece& new_piece(std::int32_t parent = -1);
   void configure_body(btSoftBody& body, const Piece* parent);
@@ -267,5 +273,31 @@ struct SkinnedSoftBody::Impl {
   bool source_chosen_ = false;  // a pose source was set: the first substep starts on its pose
   ApplyStats stats_;
 };
+
+// --- The inline queries of the books ---
+
+inline btSoftBody* SkinnedSoftBody::Impl::body_of(std::int32_t v) const {
+  const std::int32_t p = piece_of_[static_cast<std::size_t>(v)];
+  return p < 0 ? nullptr : pieces_[static_cast<std::size_t>(p)]->body.get();
+}
+
+// The node of an attached vertex (its body deleted by the application: refused).
+inline const btSoftBody::Node& SkinnedSoftBody::Impl::node(std::int32_t v) const {
+  const btSoftBody* body = body_of(v);
+  if (!body) throw std::logic_error("SkinnedSoftBody: " + pieces_.lost());
+  return body->m_nodes[node_of_[static_cast<std::size_t>(v)]];
+}
+
+inline Eigen::Vector3d SkinnedSoftBody::Impl::position(std::int32_t v) const {
+  const auto i = static_cast<std::size_t>(v);
+  if (piece_of_[i] < 0) return detached_.position(v);
+  return from_bt(node(v).m_x);
+}
+
+inline Eigen::Vector3d SkinnedSoftBody::Impl::velocity(std::int32_t v) const {
+  const auto i = static_cast<std::size_t>(v);
+  if (piece_of_[i] < 0) return detached_.velocity(v);
+  return from_bt(node(v).m_v);
+}
 
 }  // namespace conform::bullet

@@ -8,8 +8,9 @@
 #include <stdexcept>
 
 #include "conform/membrane/crack_extension.hpp"
+#include "edge_key.hpp"
 #include "phase_clock.hpp"
-#include "piece_books.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 
