@@ -8,7 +8,8 @@
 #include <cstring>
 #include <new>
 
-#include "piece_books.hpp"
+#include "edge_key.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 
@@ -341,7 +342,7 @@ void SkinnedSoftBody::Impl::remove_bending(std::int32_t a, std::int32_t b) {
   const btSoftBody::Link& l = body.m_links[li];
   const std::int32_t c = piece.node_vertex[static_cast<std::size_t>(l.m_n[0] - &body.m_nodes[0])],
                      d = piece.node_vertex[static_cast<std::size_t>(l.m_n[1] - &body.m_nodes[0])];
-  keep_rest(a, b, std::min(c, d), std::max(c, d), piece.rest[static_cast<std::size_t>(li)], true);
+  kept_.keep(a, b, std::min(c, d), std::max(c, d), piece.rest[static_cast<std::size_t>(li)], true);
   remove_link(p, li);
   --stats_.removed_links;
   ++stats_.removed_bending;

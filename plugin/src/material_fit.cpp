@@ -7,19 +7,12 @@
 namespace conform::bullet {
 namespace {
 
-// The link-only fields (Material: "bullet_links: ...") that differ from their defaults.
+// The link-only fields (kLinkOnlyFields) that differ from their defaults.
 std::vector<std::string> set_link_fields(const Material& m) {
   const Material d;
   std::vector<std::string> out;
-  const auto check = [&](const char* name, double value, double fallback) {
-    if (value != fallback) out.push_back(name);
-  };
-  check("link_stiffness", m.link_stiffness, d.link_stiffness);
-  check("damping", m.damping, d.damping);
-  check("pretension", m.pretension, d.pretension);
-  check("target_stiffness", m.target_stiffness, d.target_stiffness);
-  check("target_damping", m.target_damping, d.target_damping);
-  check("kinematic_weight", m.kinematic_weight, d.kinematic_weight);
+  for (const MaterialField& f : kLinkOnlyFields)
+    if (m.*f.value != d.*f.value) out.push_back(f.name);
   return out;
 }
 

@@ -2,7 +2,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "piece_books.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 

@@ -1,18 +1,25 @@
 // The piece books: making the bodies (one per connected piece), moving a whole piece into a
-// new body, detaching a vertex, and the link rest lengths and bending links kept through a
-// change.
-#include "piece_books.hpp"
-
+// new body, detaching a vertex, and the bending links made again after a change.
 #include <algorithm>
+#include <new>
+#include <span>
 
 #include "bullet_surgery.hpp"
 #include "conform/mesh/analysis.hpp"
+#include "edge_key.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 
-SkinnedSoftBody::Impl::PieceBody::~PieceBody() {
-  if (owner) owner->body_deleted_by_app(slot);
-}
+/// One whole connected piece on its way into a new body (move_to_new_piece and its steps).
+struct SkinnedSoftBody::Impl::PieceMove {
+  std::span<const std::int32_t> moving;  // its vertices; node i of the new body is moving[i]
+  std::vector<std::int32_t> sources;     // bodies the nodes leave (normally one)
+  std::vector<std::int32_t> faces;       // mesh faces, each once
+  std::vector<std::vector<std::uint8_t>> marks;  // per source body: per link, 1 if it moves
+  std::size_t link_count = 0;                    // links marked
+  std::int32_t into = -1;                        // the new body's index
+};
 
 SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece(std::int32_t parent) {
   const auto slot = std::int32_t(pieces_.size());
@@ -22,19 +29,16 @@ SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::new_piece(std::int32_t pare
                           : nullptr;
   auto piece = std::make_unique<Piece>();
   // This constructor (unlike the world-info-only one) creates the default material.
-  piece->body = std::make_unique<PieceBody>(info_, this, slot);
+  piece->body = std::make_unique<PieceBody>(info_, &pieces_, slot);
   piece->settings = from ? from->settings : defaults_;
   piece->released = from && from->released;
   if (from) piece->release = from->release;
   btSoftBody& body = *piece->body;
   configure_body(body, from);
   link_.add(&body, piece->settings.collision_group, piece->settings.collision_mask);
-  pieces_.push_back(std::move(piece));
-  generation_.push_back(1);
-  events_.push_back(
-      {PieceEvent::Kind::created, id_of_slot(slot), from ? id_of_slot(parent) : PieceId{}});
+  Piece& added = pieces_.add(std::move(piece), from ? parent : -1);
   ++stats_.new_pieces;
-  return *pieces_.back();
+  return added;
 }
 
 void SkinnedSoftBody::Impl::configure_body(btSoftBody& body, const Piece* from) {
@@ -85,7 +89,7 @@ void SkinnedSoftBody::Impl::build(const mesh::SkinnedMesh& m) {
   const auto n = static_cast<std::size_t>(m.vertex_count());
   area_mark_.assign(n, 0);
   seed_mark_.assign(n, 0);
-  clear_kept();
+  kept_.clear();
   bend_dirty_.clear();
   stats_ = {};
 }
@@ -96,7 +100,8 @@ void SkinnedSoftBody::Impl::reserve_books(const mesh::SkinnedMesh& m) {
   const auto n = static_cast<std::size_t>(m.vertex_count());
   split_.reserve(std::int32_t(2 * n));
   split_.begin(std::int32_t(n));
-  for (auto* table : {&piece_of_, &node_of_, &detached_slot_, &move_slot_}) table->reserve(2 * n);
+  for (auto* table : {&piece_of_, &node_of_, &move_slot_}) table->reserve(2 * n);
+  detached_.reserve(2 * n);
   for (auto* table : {&area_mark_, &seed_mark_, &pinned_, &kinematic_}) table->reserve(2 * n);
   mass_.reserve(2 * n);
   vertex_faces_.reserve(2 * n);
@@ -115,7 +120,7 @@ void SkinnedSoftBody::Impl::index_faces(const mesh::SkinnedMesh& m) {
   vertex_faces_.assign(n, {});
   piece_of_.assign(n, -1);
   node_of_.assign(n, -1);
-  detached_slot_.assign(n, -1);
+  detached_.reset(n);
   for (std::size_t f = 0; f < faces_.size(); ++f) {
     for (const auto v : faces_[f])
       vertex_faces_[static_cast<std::size_t>(v)].push_back(std::int32_t(f));
@@ -156,10 +161,7 @@ void SkinnedSoftBody::Impl::place_nodes(const mesh::SkinnedMesh& m, const mesh::
   for (std::int32_t v = 0; v < m.vertex_count(); ++v) {
     const auto& vf = vertex_faces_[static_cast<std::size_t>(v)];
     if (vf.empty()) {  // no faces: not a node (its mass stays in the books)
-      detached_slot_[static_cast<std::size_t>(v)] = std::int32_t(detached_state_.size());
-      detached_state_.emplace_back(m.current.col(v), Eigen::Vector3d::Zero());
-      detached_vertex_.push_back(v);
-      ++detached_count_;
+      detached_.add(v, m.current.col(v), Eigen::Vector3d::Zero());
       continue;
     }
     add_node(
@@ -186,12 +188,10 @@ void SkinnedSoftBody::Impl::place_faces_and_links(const mesh::SkinnedMesh& m) {
 void SkinnedSoftBody::Impl::drop_empty_pieces() {
   // Pieces left without nodes leave the world.
   for (std::size_t slot = 0; slot < pieces_.size(); ++slot) {
-    auto& piece = pieces_[slot];
+    const auto& piece = pieces_[slot];
     if (!piece || !piece->body || piece->body->m_nodes.size() != 0) continue;
-    events_.push_back({PieceEvent::Kind::removed, id_of_slot(std::int32_t(slot)), {}});
     link_.remove(piece->body.get());
-    piece.reset();
-    ++generation_[slot];  // every id of it is stale from now on
+    pieces_.remove(std::int32_t(slot));
   }
 }
 
@@ -199,34 +199,8 @@ void SkinnedSoftBody::Impl::detach(std::int32_t v) {
   const auto i = static_cast<std::size_t>(v);
   const Eigen::Vector3d x = position(v), vel = velocity(v);
   remove_node(v);
-  detached_slot_[i] = std::int32_t(detached_state_.size());
-  detached_state_.emplace_back(x, vel);
-  detached_vertex_.push_back(v);
-  ++detached_count_;
+  detached_.add(v, x, vel);
   ++stats_.detached_nodes;
-}
-
-void SkinnedSoftBody::Impl::keep_rest(std::int32_t a, std::int32_t b, std::int32_t c,
-                                      std::int32_t d, double rest, bool bending) {
-  (bending ? relink_bend_ : relink_edge_).insert(a, b, std::int32_t(relink_.size()), true);
-  relink_.emplace_back(a, b, c, d, rest);
-}
-
-double SkinnedSoftBody::Impl::kept_rest(std::int32_t a, std::int32_t b, std::int32_t c,
-                                        std::int32_t d, bool bending) const {
-  const std::int32_t i = (bending ? relink_bend_ : relink_edge_).find(a, b);
-  if (i < 0) return -1;
-  const auto& [ka, kb, kc, kd, rest] = relink_[static_cast<std::size_t>(i)];
-  return kc == c && kd == d ? rest : -1;
-}
-
-void SkinnedSoftBody::Impl::clear_kept() {
-  for (std::size_t i = 0; i < relink_.size(); ++i) {
-    const auto& [a, b, c, d, rest] = relink_[i];
-    const bool bending = !(a == c && b == d);
-    (bending ? relink_bend_ : relink_edge_).erase(a, b, std::int32_t(i));
-  }
-  relink_.clear();
 }
 
 void SkinnedSoftBody::Impl::refresh_bending(std::int32_t a, std::int32_t b) {
@@ -248,7 +222,7 @@ void SkinnedSoftBody::Impl::refresh_bending(std::int32_t a, std::int32_t b) {
   const std::int32_t c = third_vertex(faces_[static_cast<std::size_t>(found[0])], a, b),
                      d = third_vertex(faces_[static_cast<std::size_t>(found[1])], a, b);
   if (c < 0 || d < 0 || c == d) return;
-  double rest = kept_rest(a, b, std::min(c, d), std::max(c, d), true);
+  double rest = kept_.find(a, b, std::min(c, d), std::max(c, d), true);
   if (rest < 0) rest = (1 - material_.pretension) * (position(c) - position(d)).norm();
   add_bending(p, a, b, c, d, rest);
 }

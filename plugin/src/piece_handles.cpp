@@ -1,49 +1,60 @@
-// Pieces as the application sees them: generation-checked ids over the piece slots, the events
-// queued by an edit and delivered after it, the settings a split inherits, and the guard that
-// refuses an edit inside a step or after the application deleted a piece's body.
+// The piece slots and their ids, events and per-piece settings (piece_handles.hpp).
+#include "piece_handles.hpp"
+
 #include <stdexcept>
 #include <string>
 
-#include "piece_books.hpp"
-
 namespace conform::bullet {
 
-PieceId SkinnedSoftBody::Impl::id_of_slot(std::int32_t slot) const {
-  return {slot, generation_[static_cast<std::size_t>(slot)]};
+PieceBody::~PieceBody() {
+  if (owner) owner->body_deleted(slot);
 }
 
-std::vector<PieceId> SkinnedSoftBody::Impl::piece_ids() const {
+Piece& PieceHandles::add(std::unique_ptr<Piece> piece, std::int32_t parent) {
+  const auto slot = std::int32_t(pieces_.size());
+  pieces_.push_back(std::move(piece));
+  generation_.push_back(1);
+  events_.push_back(
+      {PieceEvent::Kind::created, id_of(slot), parent >= 0 ? id_of(parent) : PieceId{}});
+  return *pieces_.back();
+}
+
+void PieceHandles::remove(std::int32_t slot) {
+  const auto s = static_cast<std::size_t>(slot);
+  events_.push_back({PieceEvent::Kind::removed, id_of(slot), {}});
+  pieces_[s].reset();
+  ++generation_[s];  // every id of it is stale from now on
+}
+
+void PieceHandles::body_deleted(std::int32_t slot) {
+  auto& piece = pieces_[static_cast<std::size_t>(slot)];
+  (void)piece->body.release();  // being deleted by the application: never ours to delete
+  ++generation_[static_cast<std::size_t>(slot)];
+  if (lost_.empty())
+    lost_ = "the btSoftBody of piece " + std::to_string(slot) +
+            " was deleted by the application (Bullet's teardown) while its skinned body "
+            "lives; destroy the plugin or the skinned body (Plugin::remove_skinned_body)";
+}
+
+std::vector<PieceId> PieceHandles::ids() const {
   std::vector<PieceId> out;
   for (std::size_t s = 0; s < pieces_.size(); ++s)
-    if (pieces_[s] && pieces_[s]->body) out.push_back(id_of_slot(std::int32_t(s)));
+    if (pieces_[s] && pieces_[s]->body) out.push_back(id_of(std::int32_t(s)));
   return out;
 }
 
-bool SkinnedSoftBody::Impl::piece_valid(PieceId id) const {
+bool PieceHandles::valid(PieceId id) const {
   if (id.index < 0 || std::size_t(id.index) >= pieces_.size()) return false;
   const auto s = static_cast<std::size_t>(id.index);
   return generation_[s] == id.generation && pieces_[s] && pieces_[s]->body;
 }
 
-btSoftBody* SkinnedSoftBody::Impl::piece_body(PieceId id) const {
-  return piece_valid(id) ? pieces_[static_cast<std::size_t>(id.index)]->body.get() : nullptr;
+btSoftBody* PieceHandles::body(PieceId id) const {
+  return valid(id) ? pieces_[static_cast<std::size_t>(id.index)]->body.get() : nullptr;
 }
 
-PieceId SkinnedSoftBody::Impl::piece_of(std::int32_t vertex) const {
-  if (vertex < 0 || vertex >= vertex_count())
-    throw std::out_of_range("SkinnedSoftBody::piece_of: vertex " + std::to_string(vertex) +
-                            " out of range [0, " + std::to_string(vertex_count()) + ")");
-  const std::int32_t p = piece_of_[static_cast<std::size_t>(vertex)];
-  return p < 0 ? PieceId{} : id_of_slot(p);
-}
-
-void SkinnedSoftBody::Impl::on_piece_event(std::function<void(const PieceEvent&)> listener) {
-  if (listener) listeners_.push_back(std::move(listener));
-}
-
-SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::live_piece(PieceId id,
-                                                                const char* what) const {
-  if (!piece_valid(id))
+Piece& PieceHandles::live(PieceId id, const char* what) const {
+  if (!valid(id))
     throw std::invalid_argument(std::string("SkinnedSoftBody::") + what + ": piece id (slot " +
                                 std::to_string(id.index) + ", generation " +
                                 std::to_string(id.generation) +
@@ -52,41 +63,17 @@ SkinnedSoftBody::Impl::Piece& SkinnedSoftBody::Impl::live_piece(PieceId id,
   return *pieces_[static_cast<std::size_t>(id.index)];
 }
 
-const PieceSettings& SkinnedSoftBody::Impl::piece_settings(PieceId id) const {
-  return live_piece(id, "piece_settings").settings;
-}
-
-void SkinnedSoftBody::Impl::set_piece_user(PieceId id, void* user) {
-  Piece& piece = live_piece(id, "set_piece_user");
+void PieceHandles::set_user(PieceId id, void* user) {
+  Piece& piece = live(id, "set_piece_user");
   piece.settings.user = user;
   piece.body->setUserPointer(user);
 }
 
-void SkinnedSoftBody::Impl::set_piece_collision(PieceId id, int group, int mask) {
-  check_editable("set_piece_collision");
-  Piece& piece = live_piece(id, "set_piece_collision");
-  piece.settings.collision_group = group;
-  piece.settings.collision_mask = mask;
-  // Bullet reads the filter when it makes the broadphase proxy: out of the world and back in.
-  link_.remove(piece.body.get());
-  link_.add(piece.body.get(), group, mask);
+void PieceHandles::listen(std::function<void(const PieceEvent&)> listener) {
+  if (listener) listeners_.push_back(std::move(listener));
 }
 
-bool SkinnedSoftBody::Impl::piece_released(PieceId id) const {
-  return live_piece(id, "piece_released").released;
-}
-
-void SkinnedSoftBody::Impl::check_editable(const char* what) const {
-  if (link_.stepping && link_.stepping())
-    throw std::logic_error(std::string("SkinnedSoftBody::") + what +
-                           ": called inside stepSimulation (from a step hook or other code the "
-                           "step runs); Bullet's contacts hold node pointers until the step "
-                           "ends, so edit between stepSimulation calls");
-  if (!lost_.empty())
-    throw std::logic_error(std::string("SkinnedSoftBody::") + what + ": " + lost_);
-}
-
-void SkinnedSoftBody::Impl::deliver_events() {
+void PieceHandles::deliver() {
   // Swapped out first: a listener's own queries never see a half-delivered queue.
   std::vector<PieceEvent> events;
   events.swap(events_);
@@ -94,14 +81,9 @@ void SkinnedSoftBody::Impl::deliver_events() {
     for (auto& listener : listeners_) listener(event);
 }
 
-void SkinnedSoftBody::Impl::body_deleted_by_app(std::int32_t slot) {
-  auto& piece = pieces_[static_cast<std::size_t>(slot)];
-  (void)piece->body.release();  // being deleted by the application: never ours to delete
-  ++generation_[static_cast<std::size_t>(slot)];
-  if (lost_.empty())
-    lost_ = "the btSoftBody of piece " + std::to_string(slot) +
-            " was deleted by the application (Bullet's teardown) while its skinned body "
-            "lives; destroy the plugin or the skinned body (Plugin::remove_skinned_body)";
+void PieceHandles::destroyed() {
+  events_.clear();
+  for (auto& listener : listeners_) listener({PieceEvent::Kind::body_destroyed, {}, {}});
 }
 
 }  // namespace conform::bullet

@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include "bullet_surgery.hpp"
-#include "piece_books.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 
@@ -25,7 +25,7 @@ void require(bool ok, const char* field, double value, const char* range) {
 
 void SkinnedSoftBody::Impl::release_piece(PieceId id, const ReleaseOptions& options) {
   check_editable("release_piece");
-  Piece& piece = live_piece(id, "release_piece");
+  Piece& piece = pieces_.live(id, "release_piece");
   const auto finite = [](double v) { return std::isfinite(v); };
   require(
       finite(options.link_stiffness) && options.link_stiffness > 0 && options.link_stiffness <= 1,

@@ -10,7 +10,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "piece_books.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 

@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "piece_books.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 

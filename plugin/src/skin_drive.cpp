@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "bullet_surgery.hpp"
-#include "piece_books.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 
@@ -131,7 +131,8 @@ void SkinDrive::advance(const mesh::SkinnedMesh& mesh, double time) {
 // --- The per-substep drive ---
 
 void SkinnedSoftBody::Impl::update(double dt, double time) {
-  if (!lost_.empty()) throw std::logic_error("SkinnedSoftBody: cannot step: " + lost_);
+  if (!pieces_.lost().empty())
+    throw std::logic_error("SkinnedSoftBody: cannot step: " + pieces_.lost());
   if (!(dt > 0)) return;
   time_ = time;
   if (!started_) {
@@ -149,11 +150,11 @@ void SkinnedSoftBody::Impl::update(double dt, double time) {
     clock_now_ = time;
   }
   drive_.advance(mesh_, clock_now_);
-  for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot) {
+  for (std::int32_t slot = 0; slot < detached_.count(); ++slot) {
     // A detached vertex rides its target.
-    const auto v = static_cast<std::size_t>(detached_vertex_[slot]);
+    const auto v = static_cast<std::size_t>(detached_.vertex(slot));
     const Eigen::Vector3d t = drive_.target(std::int32_t(v)), tp = drive_.previous_target(v);
-    detached_state_[slot] = {t, (t - tp) / dt};
+    detached_.set(slot, t, (t - tp) / dt);
   }
   hold_released_volumes(dt);
   if (membrane_model()) {
@@ -267,8 +268,8 @@ void SkinnedSoftBody::Impl::place_on_pose() {
     }
     refit_tree(body.m_ndbvt.m_root);  // the leaves moved: their ancestors follow
   }
-  for (std::size_t slot = 0; slot < detached_vertex_.size(); ++slot)
-    detached_state_[slot] = {drive_.target(detached_vertex_[slot]), Eigen::Vector3d::Zero()};
+  for (std::int32_t slot = 0; slot < detached_.count(); ++slot)
+    detached_.set(slot, drive_.target(detached_.vertex(slot)), Eigen::Vector3d::Zero());
   membrane_.invalidate();  // its carried solution is of the old positions
 }
 

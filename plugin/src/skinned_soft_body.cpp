@@ -9,9 +9,10 @@
 #include <string>
 
 #include "conform/skin/limb_axes.hpp"
+#include "edge_key.hpp"
 #include "material_fit.hpp"
 #include "phase_clock.hpp"
-#include "piece_books.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 
@@ -162,8 +163,7 @@ SkinnedSoftBody::Impl::~Impl() {
   // the application deleted are gone from the books already (PieceBody).
   for (auto& piece : pieces_)
     if (piece && piece->body && piece->body->getBroadphaseHandle()) link_.remove(piece->body.get());
-  events_.clear();
-  for (auto& listener : listeners_) listener({PieceEvent::Kind::body_destroyed, {}, {}});
+  pieces_.destroyed();
 }
 
 void SkinnedSoftBody::Impl::play(const skin::Animation& animation, skin::Blend blend, bool loop) {
@@ -321,13 +321,41 @@ std::int32_t SkinnedSoftBody::Impl::bending_link_count() const {
   return n;
 }
 
+PieceId SkinnedSoftBody::Impl::piece_of(std::int32_t vertex) const {
+  if (vertex < 0 || vertex >= vertex_count())
+    throw std::out_of_range("SkinnedSoftBody::piece_of: vertex " + std::to_string(vertex) +
+                            " out of range [0, " + std::to_string(vertex_count()) + ")");
+  const std::int32_t p = piece_of_[static_cast<std::size_t>(vertex)];
+  return p < 0 ? PieceId{} : pieces_.id_of(p);
+}
+
+void SkinnedSoftBody::Impl::set_piece_collision(PieceId id, int group, int mask) {
+  check_editable("set_piece_collision");
+  Piece& piece = pieces_.live(id, "set_piece_collision");
+  piece.settings.collision_group = group;
+  piece.settings.collision_mask = mask;
+  // Bullet reads the filter when it makes the broadphase proxy: out of the world and back in.
+  link_.remove(piece.body.get());
+  link_.add(piece.body.get(), group, mask);
+}
+
+void SkinnedSoftBody::Impl::check_editable(const char* what) const {
+  if (link_.stepping && link_.stepping())
+    throw std::logic_error(std::string("SkinnedSoftBody::") + what +
+                           ": called inside stepSimulation (from a step hook or other code the "
+                           "step runs); Bullet's contacts hold node pointers until the step "
+                           "ends, so edit between stepSimulation calls");
+  if (!pieces_.lost().empty())
+    throw std::logic_error(std::string("SkinnedSoftBody::") + what + ": " + pieces_.lost());
+}
+
 // --- SkinnedSoftBody: forwards to its Impl ---
 
 SkinnedSoftBody::SkinnedSoftBody(const WorldLink& link, const mesh::SkinnedMesh& mesh,
                                  const skin::Skeleton& skeleton, const Material& material,
                                  const PieceSettings& settings)
     : impl_(std::make_unique<Impl>(link, mesh, skeleton, material, settings)) {
-  impl_->events_.clear();  // the pieces made here are listed by piece_ids(), not announced
+  impl_->pieces_.drop_events();  // the pieces made here are listed by piece_ids(), not announced
 }
 SkinnedSoftBody::~SkinnedSoftBody() = default;
 
@@ -375,13 +403,13 @@ void SkinnedSoftBody::set_pinned(std::span<const std::int32_t> vertices) {
 mesh::CutResult SkinnedSoftBody::cut(const cga::Plane<double>& plane,
                                      const mesh::CutOptions& options) {
   auto result = impl_->cut(plane, options);
-  impl_->deliver_events();
+  impl_->pieces_.deliver();
   return result;
 }
 mesh::DrillResult SkinnedSoftBody::drill(const mesh::DrillTool& tool,
                                          const mesh::DrillOptions& options) {
   auto result = impl_->drill(tool, options);
-  impl_->deliver_events();
+  impl_->pieces_.deliver();
   return result;
 }
 void SkinnedSoftBody::begin_tear(const mesh::TearOptions& options) {
@@ -389,7 +417,7 @@ void SkinnedSoftBody::begin_tear(const mesh::TearOptions& options) {
 }
 mesh::TearStep SkinnedSoftBody::tear_advance(const mesh::ScalpelSample& sample) {
   auto step = impl_->tear_advance(sample);
-  impl_->deliver_events();
+  impl_->pieces_.deliver();
   return step;
 }
 const mesh::Tear* SkinnedSoftBody::tear() const {
@@ -404,7 +432,7 @@ double SkinnedSoftBody::tear_grown_length() const {
 }
 void SkinnedSoftBody::apply(const mesh::TopologyChange& change) {
   impl_->apply(change);
-  impl_->deliver_events();
+  impl_->pieces_.deliver();
 }
 const ApplyStats& SkinnedSoftBody::last_apply() const {
   return impl_->last_apply();
@@ -490,25 +518,25 @@ std::int32_t SkinnedSoftBody::detached_count() const {
 }
 
 std::vector<PieceId> SkinnedSoftBody::piece_ids() const {
-  return impl_->piece_ids();
+  return impl_->pieces_.ids();
 }
 bool SkinnedSoftBody::piece_valid(PieceId id) const {
-  return impl_->piece_valid(id);
+  return impl_->pieces_.valid(id);
 }
 btSoftBody* SkinnedSoftBody::piece_body(PieceId id) const {
-  return impl_->piece_body(id);
+  return impl_->pieces_.body(id);
 }
 PieceId SkinnedSoftBody::piece_of(std::int32_t vertex) const {
   return impl_->piece_of(vertex);
 }
 void SkinnedSoftBody::on_piece_event(std::function<void(const PieceEvent&)> listener) {
-  impl_->on_piece_event(std::move(listener));
+  impl_->pieces_.listen(std::move(listener));
 }
 const PieceSettings& SkinnedSoftBody::piece_settings(PieceId id) const {
-  return impl_->piece_settings(id);
+  return impl_->pieces_.settings(id);
 }
 void SkinnedSoftBody::set_piece_user(PieceId id, void* user) {
-  impl_->set_piece_user(id, user);
+  impl_->pieces_.set_user(id, user);
 }
 void SkinnedSoftBody::set_piece_collision(PieceId id, int group, int mask) {
   impl_->set_piece_collision(id, group, mask);
@@ -517,7 +545,7 @@ void SkinnedSoftBody::release_piece(PieceId id, const ReleaseOptions& options) {
   impl_->release_piece(id, options);
 }
 bool SkinnedSoftBody::piece_released(PieceId id) const {
-  return impl_->piece_released(id);
+  return impl_->pieces_.released(id);
 }
 
 std::uint64_t SkinnedSoftBody::topology_version() const {

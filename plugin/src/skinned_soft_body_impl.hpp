@@ -1,14 +1,18 @@
 // SkinnedSoftBody's private side: the books mirroring the mesh into Bullet (per vertex, per
 // face, per edge), the skin drive and the scratch of topology changes. The public class
-// forwards to it (skinned_soft_body.hpp describes the behaviour). Its members live by concept:
+// forwards to it (skinned_soft_body.hpp describes the behaviour). Parts that own their state
+// (each header states its invariant): PieceHandles (piece_handles.hpp), KeptRest
+// (kept_rest.hpp), DetachedVertices (detached_vertices.hpp), SkinDrive, MembraneDrive,
+// TearGrowth. Its own members live by concept:
 //   skinned_soft_body.cpp  facade: construction, edit entry points, queries, forwarders;
 //   skin_drive.cpp         pose source, skinned targets, the per-substep update;
 //   bullet_surgery.cpp     add/remove of nodes, faces and links, link constants, node areas;
-//   piece_books.cpp        bodies per piece, moving a piece, detaching, kept rest lengths;
+//   piece_books.cpp        bodies per piece, moving a piece, detaching, bending links;
 //   topology_mirror.cpp    a TopologyChange into Bullet, in phases over a MirrorContext;
-//   piece_handles.cpp      piece ids, events, per-piece settings, the edit guard;
 //   piece_release.cpp      releasing a piece from skinning (a free Bullet soft body).
 #pragma once
+
+#include <BulletSoftBody/btSoftBody.h>
 
 #include <Eigen/Core>
 #include <cstdint>
@@ -16,17 +20,22 @@
 #include <memory>
 #include <optional>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
 
+#include "conform/bullet/convert.hpp"
 #include "conform/bullet/skinned_soft_body.hpp"
 #include "conform/mesh/adjacency.hpp"
 #include "conform/mesh/analysis.hpp"
 #include "conform/mesh/face_index.hpp"
 #include "conform/mesh/split_search.hpp"
+#include "detached_vertices.hpp"
+#include "kept_rest.hpp"
 #include "membrane_drive.hpp"
+#include "piece_handles.hpp"
 #include "skin_drive.hpp"
 #include "tear_growth.hpp"
 
@@ -87,7 +96,7 @@ struct SkinnedSoftBody::Impl {
   std::int32_t vertex_count() const { return mesh_.vertex_count(); }
   std::int32_t piece_count() const;
   std::vector<btSoftBody*> pieces() const;
-  inline Eigen::Vector3d position(std::int32_t vertex) const;  // piece_books.hpp
+  inline Eigen::Vector3d position(std::int32_t vertex) const;  // below
   inline Eigen::Vector3d velocity(std::int32_t vertex) const;
   double mass(std::int32_t vertex) const { return mass_[static_cast<std::size_t>(vertex)]; }
   bool kinematic(std::int32_t vertex) const { return kinematic_[static_cast<std::size_t>(vertex)]; }
@@ -108,31 +117,17 @@ struct SkinnedSoftBody::Impl {
   bool detached(std::int32_t vertex) const {
     return piece_of_[static_cast<std::size_t>(vertex)] < 0;
   }
-  std::int32_t detached_count() const { return detached_count_; }
+  std::int32_t detached_count() const { return detached_.count(); }
   bool is_kinematic_by_weight(std::int32_t vertex) const;
 
-  // --- Piece handles, events, settings, edit guard (piece_handles.cpp) ---
-  std::vector<PieceId> piece_ids() const;
-  bool piece_valid(PieceId id) const;
-  btSoftBody* piece_body(PieceId id) const;
+  // --- Pieces (ids, events, per-piece settings: pieces_, piece_handles.hpp) ---
+  using Piece = bullet::Piece;
+  using PieceBody = bullet::PieceBody;
   PieceId piece_of(std::int32_t vertex) const;
-  PieceId id_of_slot(std::int32_t slot) const;
-  void on_piece_event(std::function<void(const PieceEvent&)> listener);
-  const PieceSettings& piece_settings(PieceId id) const;
-  void set_piece_user(PieceId id, void* user);
   void set_piece_collision(PieceId id, int group, int mask);
-  bool piece_released(PieceId id) const;
-  struct Piece;      // piece_books.hpp
-  struct PieceBody;  // piece_books.hpp
-  /// The live piece `id` names; throws std::invalid_argument naming `what` when stale.
-  Piece& live_piece(PieceId id, const char* what) const;
   /// Throws std::logic_error when an edit named `what` may not run now: inside a step, or
   /// after the application deleted a piece's body.
   void check_editable(const char* what) const;
-  /// Hands the events queued by the last edit to the listeners.
-  void deliver_events();
-  /// Called by a PieceBody the application deletes.
-  void body_deleted_by_app(std::int32_t slot);
   // --- Render data (render_data.cpp) ---
   Eigen::Matrix3Xd normals() const;
   std::vector<skin::Versor> joint_transforms() const;
@@ -157,7 +152,7 @@ struct SkinnedSoftBody::Impl {
   void reapply_rest_lengths(Piece& piece);
 
   // --- Piece books (piece_books.cpp) ---
-  struct PieceMove;  // piece_books.hpp
+  struct PieceMove;  // piece_books.cpp
   /// A new, empty piece in the world; its settings from `parent` (a slot; −1: the defaults).
   Piece& new_piece(std::int32_t parent = -1);
   void configure_body(btSoftBody& body, const Piece* parent);
@@ -181,12 +176,6 @@ struct SkinnedSoftBody::Impl {
   void move_faces(PieceMove& move);
   void move_links(PieceMove& move);
   std::vector<btDbvtNode*> leave_old_bodies(PieceMove& move);
-  // Links removed during one change whose link may come back keep their rest length.
-  void keep_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d, double rest,
-                 bool bending);
-  double kept_rest(std::int32_t a, std::int32_t b, std::int32_t c, std::int32_t d,
-                   bool bending) const;
-  void clear_kept();
   void refresh_bending(std::int32_t a, std::int32_t b);
 
   // --- Bullet surgery (bullet_surgery.cpp) ---
@@ -265,28 +254,18 @@ struct SkinnedSoftBody::Impl {
   // Per undirected edge (min, max) crossed by a bending link: its link index in its piece.
   mesh::EdgeMap bend_link_;
   // Detached vertices: their position and velocity when they left Bullet.
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> detached_state_;
-  std::vector<std::int32_t> detached_slot_;    // per vertex, −1 unless detached
-  std::vector<std::int32_t> detached_vertex_;  // per slot
-  std::int32_t detached_count_ = 0;
+  DetachedVertices detached_;
   // The split search of a change (its per-vertex labels stay allocated between changes).
   mesh::SplitSearch split_;
   std::vector<std::int32_t> move_slot_;  // per vertex: its node in a new body (−1 between)
-  // Links removed during one change whose link may come back: (a, b, c, d, rest), where (a, b)
-  // is the key edge and (c, d) the end vertices (equal to (a, b) for an edge link).
-  std::vector<std::tuple<std::int32_t, std::int32_t, std::int32_t, std::int32_t, double>> relink_;
-  mesh::EdgeMap relink_edge_, relink_bend_;          // key edge → index in relink_
+  KeptRest kept_;  // rest lengths of the links a change removed that may come back
   std::vector<std::uint8_t> area_mark_, seed_mark_;  // per vertex scratch, 0 between changes
   // Edges whose bending link may have to be made again at the end of a change.
   std::vector<std::pair<std::int32_t, std::int32_t>> bend_dirty_;
 
-  std::vector<std::unique_ptr<Piece>> pieces_;  // null once emptied
-  std::vector<std::uint32_t> generation_;       // per slot; changes when its piece is removed
-  std::vector<std::function<void(const PieceEvent&)>> listeners_;
-  std::vector<PieceEvent> events_;      // queued during an edit, delivered after it
-  std::string lost_;                    // why the body is unusable (a piece deleted by the app)
-  double time_ = 0;                     // of the last substep (targets after an edit)
-  std::uint64_t topology_version_ = 0;  // changes mirrored
+  PieceHandles pieces_;
+  double time_ = 0;                           // of the last substep (targets after an edit)
+  std::uint64_t topology_version_ = 0;        // changes mirrored
   std::optional<mesh::ScalpelSample> blade_;  // the last tear sample (debug drawing)
   std::optional<Clock> clock_;                // the body's own animation clock, when set
   double clock_now_ = 0;                      // the time the pose source was last sampled at
@@ -294,5 +273,31 @@ struct SkinnedSoftBody::Impl {
   bool source_chosen_ = false;  // a pose source was set: the first substep starts on its pose
   ApplyStats stats_;
 };
+
+// --- The inline queries of the books ---
+
+inline btSoftBody* SkinnedSoftBody::Impl::body_of(std::int32_t v) const {
+  const std::int32_t p = piece_of_[static_cast<std::size_t>(v)];
+  return p < 0 ? nullptr : pieces_[static_cast<std::size_t>(p)]->body.get();
+}
+
+// The node of an attached vertex (its body deleted by the application: refused).
+inline const btSoftBody::Node& SkinnedSoftBody::Impl::node(std::int32_t v) const {
+  const btSoftBody* body = body_of(v);
+  if (!body) throw std::logic_error("SkinnedSoftBody: " + pieces_.lost());
+  return body->m_nodes[node_of_[static_cast<std::size_t>(v)]];
+}
+
+inline Eigen::Vector3d SkinnedSoftBody::Impl::position(std::int32_t v) const {
+  const auto i = static_cast<std::size_t>(v);
+  if (piece_of_[i] < 0) return detached_.position(v);
+  return from_bt(node(v).m_x);
+}
+
+inline Eigen::Vector3d SkinnedSoftBody::Impl::velocity(std::int32_t v) const {
+  const auto i = static_cast<std::size_t>(v);
+  if (piece_of_[i] < 0) return detached_.velocity(v);
+  return from_bt(node(v).m_v);
+}
 
 }  // namespace conform::bullet

@@ -9,6 +9,7 @@
 #include "conform/bullet/skinned_soft_body.hpp"
 #include "conform/membrane/crack_extension.hpp"
 #include "conform/membrane/crack_growth.hpp"
+#include "conform/mesh/topology_change.hpp"
 #include "phase_clock.hpp"
 
 namespace conform::bullet {
@@ -71,12 +72,16 @@ void TearGrowthSettings::validate() const {
   require(snap_fraction >= 0 && snap_fraction < 0.5, "snap_fraction", snap_fraction, "[0, 0.5)");
 }
 
-const mesh::SkinnedMesh& TearGrowth::skin_mesh(const SkinnedSoftBody& body) {
+const mesh::SkinnedMesh& TearGrowth::skin_mesh(const SkinnedSoftBody& body) const {
+  return own_view_ ? view_ : body.mesh();
+}
+
+void TearGrowth::take_view(const SkinnedSoftBody& body) {
   const Eigen::Ref<const Eigen::Matrix3Xd> rest = skin_rest_();
-  if (rest.data() == body.mesh().rest.data()) return body.mesh();
+  own_view_ = rest.data() != body.mesh().rest.data();
+  if (!own_view_) return;
   view_ = body.mesh();
   view_.rest = rest;
-  return view_;
 }
 
 void TearGrowth::follow_tear(const SkinnedSoftBody& body) {
@@ -130,6 +135,7 @@ void TearGrowth::extend(SkinnedSoftBody& body, mesh::Tear& tear, std::size_t i, 
   }
   const Eigen::Vector3d from = mesh.rest.col(tip.crack.vertex);
   body.apply(ext.change);
+  if (own_view_) mesh::apply(view_, ext.change);  // as the body's mesh and its bind pose grew
   tear.adopt_growth(tip.crack.vertex, ext.duplicate, ext.new_tip);
   tear_points_ = tear.path_length();
   const Eigen::Vector3d to = skin_mesh(body).rest.col(ext.new_tip);
@@ -145,6 +151,7 @@ TearGrowthReport TearGrowth::grow(SkinnedSoftBody& body, mesh::Tear* tear) {
     return report;
   const double start = thread_seconds();
   body.sync_mesh();
+  take_view(body);
   follow_tear(body);
   // Every running tip is judged on the same state before any of them grows.
   const std::vector<std::uint8_t> fixed = fixed_vertices(body);

@@ -52,11 +52,14 @@ class TearGrowth {
   void extend(SkinnedSoftBody& body, mesh::Tear& tear, std::size_t i, TipGrowth& judged);
 
   // The body's mesh with the skin's rest state as its rest points: the body's own mesh when they
-  // are the same, else a copy refreshed on each use.
-  const mesh::SkinnedMesh& skin_mesh(const SkinnedSoftBody& body);
+  // are the same, else view_, copied once per grow() (take_view) and kept in step with the body
+  // by applying each growth step's change to it too (the bind pose grows by the same rule).
+  const mesh::SkinnedMesh& skin_mesh(const SkinnedSoftBody& body) const;
+  void take_view(const SkinnedSoftBody& body);
 
   RestSource skin_rest_;
   mesh::SkinnedMesh view_;
+  bool own_view_ = false;  // skin_mesh() is view_ (the skin's rest is not the mesh's points)
   std::vector<Tip> tips_;
   const mesh::Tear* tear_ = nullptr;
   std::int32_t tear_points_ = -1;  // the blade's path when the tips were taken

@@ -8,8 +8,9 @@
 #include <stdexcept>
 
 #include "conform/membrane/crack_extension.hpp"
+#include "edge_key.hpp"
 #include "phase_clock.hpp"
-#include "piece_books.hpp"
+#include "skinned_soft_body_impl.hpp"
 
 namespace conform::bullet {
 
@@ -36,7 +37,7 @@ void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
   if (mesh_.vertex_count() < v0 + std::int32_t(change.new_vertices.size()))
     throw std::logic_error("SkinnedSoftBody: mesh lacks the change's new vertices");
   MirrorContext c(change, v0, material_.bending_stiffness > 0, stats_.seconds, start);
-  clear_kept();
+  kept_.clear();
   bend_dirty_.clear();
   make_new_vertices(c);
   c.seconds.vertices += seconds_since(c.clock);
@@ -53,7 +54,7 @@ void SkinnedSoftBody::Impl::mirror(const mesh::TopologyChange& change) {
   refresh_changed_areas(c);
   drop_empty_pieces();
   refresh_released();
-  clear_kept();
+  kept_.clear();
   bend_dirty_.clear();
   split_.clear();
   c.seconds.insert += seconds_since(c.clock);
@@ -64,7 +65,7 @@ void SkinnedSoftBody::Impl::make_new_vertices(MirrorContext& c) {
   // proportion to the same coefficients, so Σm and Σm·v are unchanged exactly.
   piece_of_.resize(c.total, -1);
   node_of_.resize(c.total, -1);
-  detached_slot_.resize(c.total, -1);
+  detached_.grow(c.total);
   mass_.resize(c.total, 0);
   pinned_.resize(c.total, 0);
   kinematic_.resize(c.total, 0);
@@ -133,7 +134,7 @@ void SkinnedSoftBody::Impl::remove_faces(MirrorContext& c) {
     const std::int32_t li = edge_link_.find(a, b);
     if (li < 0) continue;
     const std::int32_t p = piece_of_[static_cast<std::size_t>(a)];
-    keep_rest(a, b, a, b, pieces_[static_cast<std::size_t>(p)]->rest[std::size_t(li)], false);
+    kept_.keep(a, b, a, b, pieces_[static_cast<std::size_t>(p)]->rest[std::size_t(li)], false);
     remove_link(p, li);
   }
 }
@@ -306,11 +307,7 @@ void SkinnedSoftBody::Impl::place_changed_nodes(MirrorContext& c) {
     const std::int32_t id = c.v0 + i;
     const std::int32_t group = split_.group_of(id);
     if (group == mesh::SplitSearch::kUnreached) {
-      detached_slot_[static_cast<std::size_t>(id)] = std::int32_t(detached_state_.size());
-      detached_state_.emplace_back(c.x[static_cast<std::size_t>(i)],
-                                   c.v[static_cast<std::size_t>(i)]);
-      detached_vertex_.push_back(id);
-      ++detached_count_;
+      detached_.add(id, c.x[static_cast<std::size_t>(i)], c.v[static_cast<std::size_t>(i)]);
       ++stats_.detached_nodes;
       continue;
     }
@@ -362,7 +359,7 @@ void SkinnedSoftBody::Impl::insert_faces_and_links(MirrorContext& c) {
       const auto [a, b] = edge_key(tri[k], tri[(k + 1) % 3]);
       if (c.bending) bend_dirty_.emplace_back(a, b);
       if (!(c.new_edges[i] >> k & 1u)) continue;  // it has its link
-      const double kept = kept_rest(a, b, a, b, false);
+      const double kept = kept_.find(a, b, a, b, false);
       if (kept >= 0) {
         add_link(p, a, b, kept);
         --stats_.added_links;

@@ -139,15 +139,8 @@ bullet::Material read_material(Reader& root, const bullet::Material& d) {
   // material_warnings.
   if (m.model == bullet::MaterialModel::membrane) {
     const bullet::Material none;
-    const auto unless_changed = [](double& field, double kind, double library) {
-      if (field == kind) field = library;
-    };
-    unless_changed(m.link_stiffness, d.link_stiffness, none.link_stiffness);
-    unless_changed(m.damping, d.damping, none.damping);
-    unless_changed(m.pretension, d.pretension, none.pretension);
-    unless_changed(m.target_stiffness, d.target_stiffness, none.target_stiffness);
-    unless_changed(m.target_damping, d.target_damping, none.target_damping);
-    unless_changed(m.kinematic_weight, d.kinematic_weight, none.kinematic_weight);
+    for (const bullet::MaterialField& f : bullet::kLinkOnlyFields)
+      if (m.*f.value == d.*f.value) m.*f.value = none.*f.value;
   }
   return m;
 }

@@ -64,16 +64,23 @@ std::vector<double> graded_lines(double h) {
   return lines;
 }
 
-// The sheet pinned at its border, torn along y = kTearY and settled.
-void tear_sheet(Torn& t, const bullet::Material& material, double h = 0.002) {
+// The sheet pinned at its border, torn along y = kTearY and settled. `mesh_space`: its points
+// stored that many times smaller than its bind pose, the bone's offset bringing them to it.
+void tear_sheet(Torn& t, const bullet::Material& material, double h = 0.002,
+                double mesh_space = 1) {
   const std::vector<double> lines = graded_lines(h);
   mesh::SkinnedMesh sheet = mesh::make_grid_sheet(lines, lines, Eigen::Vector3d::UnitX(),
                                                   Eigen::Vector3d::UnitY(), 2 * kHalf);
-  t.body = &t.plugin.add_skinned_body(sheet, test::one_bone_skeleton(), material);
   std::vector<std::int32_t> border;
   for (std::int32_t v = 0; v < sheet.vertex_count(); ++v)
     if (std::abs(sheet.rest(0, v)) > kHalf - 1e-9 || std::abs(sheet.rest(1, v)) > kHalf - 1e-9)
       border.push_back(v);
+  skin::Skeleton skeleton = test::one_bone_skeleton();
+  if (mesh_space != 1) {
+    sheet.rest = sheet.rest / mesh_space;
+    skeleton.bones[0].offset = skeleton.bones[0].offset * skin::Versor{{}, mesh_space};
+  }
+  t.body = &t.plugin.add_skinned_body(sheet, skeleton, material);
   t.body->set_pinned(border);
   t.w.step(5);
   t.body->begin_tear();
@@ -212,6 +219,26 @@ TEST(PluginTearGrowth, BladeAndGrowthActOnOneTear) {
     EXPECT_NE(left[i], right[i]) << i;
     EXPECT_GT(side * (body.position(left[i]).y() - body.position(right[i]).y()), 0) << i;
   }
+}
+
+TEST(PluginTearGrowth, GrowsInAMeshSpaceOfAnotherScaleAsInItsBindPose) {
+  // The growth works on the skin's rest state (the bind pose), not the stored points.
+  Torn plain, scaled;
+  tear_sheet(plain, sheet_material(1e-3));  // every judgement grows
+  tear_sheet(scaled, sheet_material(1e-3), 0.002, 100);
+  for (int call = 0; call < 2; ++call) {
+    const bullet::TearGrowthReport a = plain.body->grow_tear(), b = scaled.body->grow_tear();
+    ASSERT_EQ(a.tips.size(), b.tips.size());
+    EXPECT_GT(a.grown, 0);
+    EXPECT_NEAR(b.grown, a.grown, 1e-9);
+    for (std::size_t i = 0; i < a.tips.size(); ++i) {
+      EXPECT_EQ(b.tips[i].vertex, a.tips[i].vertex);
+      EXPECT_NEAR(b.tips[i].energy_release_rate, a.tips[i].energy_release_rate,
+                  1e-6 * a.tips[i].energy_release_rate);
+    }
+    ASSERT_EQ(scaled.body->vertex_count(), plain.body->vertex_count());
+  }
+  EXPECT_NEAR(scaled.body->tear_grown_length(), plain.body->tear_grown_length(), 1e-9);
 }
 
 TEST(PluginTearGrowth, NoGrowthBelowToughness) {

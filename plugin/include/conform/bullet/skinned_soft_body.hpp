@@ -37,6 +37,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -127,6 +128,23 @@ struct Material {
   /// default; SkinnedSoftBody::grow_tear() runs it.
   TearGrowthSettings growth{};
 };
+
+/// A number field of Material, by its name.
+struct MaterialField {
+  const char* name;
+  double Material::*value;
+};
+
+/// The fields only the bullet_links model reads, which the membrane ignores: the body names the
+/// ones set away from their defaults in its material_warnings.
+inline constexpr std::array<MaterialField, 6> kLinkOnlyFields{{
+    {"link_stiffness", &Material::link_stiffness},
+    {"damping", &Material::damping},
+    {"pretension", &Material::pretension},
+    {"target_stiffness", &Material::target_stiffness},
+    {"target_damping", &Material::target_damping},
+    {"kinematic_weight", &Material::kinematic_weight},
+}};
 
 /// How a skinned body reaches its world (Plugin::add_skinned_body makes one).
 struct WorldLink {
