@@ -196,7 +196,6 @@ void SkinnedSoftBody::Impl::drop_empty_pieces() {
 }
 
 void SkinnedSoftBody::Impl::detach(std::int32_t v) {
-  const auto i = static_cast<std::size_t>(v);
   const Eigen::Vector3d x = position(v), vel = velocity(v);
   remove_node(v);
   detached_.add(v, x, vel);

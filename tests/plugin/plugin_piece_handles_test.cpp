@@ -51,10 +51,16 @@ TEST(PluginPieceHandles, EventsAreTheChangeOfTheIdsAndRemovedIdsStayStale) {
         removed.push_back(e.piece);
       }
     }
-    for (const auto& k : after)
-      if (!before.contains(k)) EXPECT_TRUE(created.contains(k)) << "x " << x;
-    for (const auto& k : before)
-      if (!after.contains(k)) EXPECT_TRUE(gone.contains(k)) << "x " << x;
+    for (const auto& k : after) {
+      if (!before.contains(k)) {
+        EXPECT_TRUE(created.contains(k)) << "x " << x;
+      }
+    }
+    for (const auto& k : before) {
+      if (!after.contains(k)) {
+        EXPECT_TRUE(gone.contains(k)) << "x " << x;
+      }
+    }
     std::map<std::int32_t, int> per_slot;
     for (const PieceId& id : listed) {
       EXPECT_TRUE(body.piece_valid(id));
