@@ -5,9 +5,9 @@
 // `along` of its length; the tear's blade runs along the limb's outer side (or inner side), snapped
 // to the nearest point of the limb's skin sample by sample and crossing it along the skin's normal;
 // the drill goes through the limb across its axis (through a flat part along its normal). Without a
-// named bone the limb is the one where a trial on the skinned model lands the edits best (no limb:
-// the model's largest piece). Given `cut.point`, `tear.from` or `drill.tip`, an edit is placed in
-// the bind pose's bounding box as before.
+// named bone the limb is the one where a trial on the skinned model lands the edits best (the
+// whole model is the last candidate). Given `cut.point`, `tear.from` or `drill.tip`, an edit is
+// placed in the bind pose's bounding box as before.
 #pragma once
 
 #include <Eigen/Core>
