@@ -2,7 +2,6 @@
 // kinematic) and become an ordinary Bullet soft body that falls and collides, its shape held by
 // Bullet's own links at the lengths it has when released and, for a closed piece, by the
 // plugin's implicit volume step (released_volume.cpp), not Bullet's explicit kVC and kPR.
-#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -13,11 +12,6 @@
 namespace conform::bullet {
 
 namespace {
-
-// Bullet's damping (kDP) of a released piece of a membrane body when Material::damping is
-// lower: the membrane's bodies run undamped by Bullet (their damping is the membrane's), and a
-// released piece leaves the membrane.
-constexpr double kReleasedMembraneDamping = 0.01;
 
 void require(bool ok, const char* field, double value, const char* range) {
   if (ok) return;
@@ -47,10 +41,6 @@ void SkinnedSoftBody::Impl::release_piece(PieceId id, const ReleaseOptions& opti
   piece.released = true;
   piece.release = options;
   body.m_materials[0]->m_kLST = btScalar(options.link_stiffness);
-  // A membrane body's kDP is 0; undamped, the released piece's links and ground contacts rang
-  // and it sank through the ground (huesitos' severed limb). Bullet's links alone hold it now.
-  if (membrane_model())
-    body.m_cfg.kDP = btScalar(std::max(material_.damping, kReleasedMembraneDamping));
   release_nodes(piece);
   // The shape at release is the rest shape from now on (what Bullet's own reset would give).
   for (int i = 0; i < body.m_links.size(); ++i) {
