@@ -44,9 +44,7 @@ struct Character {
   std::unique_ptr<scenes::SoftWorld> world;
   bullet::SkinnedSoftBody* body = nullptr;
   Character(const std::string& file, bool membrane) : model(io::load_model(file)) {
-    // The unit the file states (FBX), else 100 units a metre: the scene's default.
-    const double units = model.unit_scale_cm > 0 ? 100 / model.unit_scale_cm : 100;
-    scenes::to_scene_frame(model, {units, "y"});
+    scenes::to_scene_frame(model, {scenes::file_units(model, file).units_per_metre, "y"});
     io::weld_model(model, {});
     scenes::CommonSettings c;
     c.substeps = 2;

@@ -134,7 +134,7 @@ void SkinnedSoftBody::Impl::update(double dt, double time) {
   if (!pieces_.lost().empty())
     throw std::logic_error("SkinnedSoftBody: cannot step: " + pieces_.lost());
   if (!(dt > 0)) return;
-  time_ = time;
+  time_ = time, last_dt_ = dt;
   if (!started_) {
     // The first substep starts on the pose source's pose at its start time, not on the bind
     // pose the body was built in: no jump (a speed spike) towards the first pose.

@@ -143,7 +143,8 @@ struct SkinnedSoftBody::Impl {
 
   // --- Skin drive (skin_drive.cpp): update() is the one per-substep entry point ---
   void update(double dt, double time);
-  std::optional<NonFiniteNode> first_non_finite_node() const;  // non_finite_check.cpp
+  std::optional<NonFiniteNode> first_non_finite_node() const;        // non_finite_check.cpp
+  Eigen::Vector3d own_velocity(const Piece& piece, int node) const;  // non_finite_check.cpp
   void skin_targets(double time);
   void drive_nodes(Piece& piece, double dt);
   // The membrane (Material::model == membrane) replaces drive_nodes and the rest lengths.
@@ -265,6 +266,7 @@ struct SkinnedSoftBody::Impl {
 
   PieceHandles pieces_;
   double time_ = 0;                           // of the last substep (targets after an edit)
+  double last_dt_ = 0;                        // the last substep's length
   std::uint64_t topology_version_ = 0;        // changes mirrored
   std::optional<mesh::ScalpelSample> blade_;  // the last tear sample (debug drawing)
   std::optional<Clock> clock_;                // the body's own animation clock, when set

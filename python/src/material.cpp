@@ -87,8 +87,10 @@ void bind_plugin_material(py::module_& m) {
       .def_readwrite("position_iterations", &Material::position_iterations)
       .def_readwrite("bending_stiffness", &Material::bending_stiffness)
       .def_readwrite("margin", &Material::margin, "m")
-      .def_readwrite("max_speed", &Material::max_speed,
-                     "world units/s: a faster node stops the step (default inf: no bound)")
+      .def_readwrite(
+          "max_speed", &Material::max_speed,
+          "world units/s: a node faster than this past its skinned target stops the step "
+          "(default inf: no bound)")
       .def_readwrite("skin", &Material::skin)
       .def_readwrite("solver", &Material::solver);
 }

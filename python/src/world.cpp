@@ -58,9 +58,9 @@ Body add_arm(const py::object& self, const bullet::Material& material, int resol
   return make_body(self, w.plugin->add_skinned_body(arm.mesh, arm.skeleton, material));
 }
 
-// File units per metre: the given number, else (None) the unit the file states (FBX's
-// UnitScaleFactor, in cm), else 100, as the character scene reads model.units_per_metre =
-// "file"; the procedural arm ("arm", "arm:N") is in metres already.
+// File units per metre: the given number, else (None) the file's own (scenes::file_units), as
+// the character scene reads model.units_per_metre = "file"; the procedural arm ("arm",
+// "arm:N") is in metres already.
 double units_per_metre(const io::SkinnedModel& model, const std::string& file,
                        const std::optional<double>& given) {
   if (given) {
@@ -70,7 +70,7 @@ double units_per_metre(const io::SkinnedModel& model, const std::string& file,
     return *given;
   }
   if (file.rfind("arm", 0) == 0 && model.source.rfind("arm", 0) == 0) return 1;
-  return model.unit_scale_cm > 0 ? 100 / model.unit_scale_cm : 100;
+  return scenes::file_units(model, file).units_per_metre;
 }
 
 Body add_model(const py::object& self, const std::string& file, const bullet::Material& material,
@@ -100,7 +100,7 @@ void bind_world(py::module_& m) {
            py::arg("units_per_metre") = py::none(), py::arg("up") = "y",
            "Adds a rigged model file (assimp; 'arm' or 'arm:N' for the procedural arm), brought "
            "to metres and Y up as the character scene does: units_per_metre file units make a "
-           "metre (None: the unit the file states, else 100), up ('y' or 'z') is the file's up "
+           "metre (None: the unit the file states, else metres), up ('y' or 'z') is the file's up "
            "axis. Raises ModelImportError for a file that cannot be read.")
       .def("step", &step, py::arg("dt") = 1.0 / 60, py::arg("substeps") = 1,
            "Advances dt seconds in `substeps` equal substeps. Raises NonFiniteState when the "

@@ -207,7 +207,10 @@ void TearRun::advance(bullet::SkinnedSoftBody& body, double t, GeometricTear* co
   for (; next_ < edit_.samples && event_due(t, edit_.time(next_)); ++next_) {
     if (next_ == 0) body.begin_tear();
     const mesh::ScalpelSample s = sample(body, t);
-    extended_ += body.tear_advance(s).extended;
+    const bool extended = body.tear_advance(s).extended;
+    extended_ += extended;
+    if (!extended && next_ > 0)
+      waits_.emplace_back(next_, body.tear() ? body.tear()->message() : "");
     // The copy takes the same stroke: in the box the same blade; on a limb the blade held by
     // its own skin, so that it owes nothing to the physics.
     if (copy) copy->advance(at_.anchors.empty() ? s : copy_sample(*copy, t));
@@ -255,6 +258,8 @@ Json TearRun::summary(const bullet::SkinnedSoftBody& body) const {
             {"tip_to_last_blade_rel", tip_to_blade_ < 0 ? -1.0 : tip_to_blade_ / bind_.diagonal()}};
   if (edit_.on_limb) j["limb"] = at_.limb;
   if (tear && !tear->message().empty()) j["message"] = tear->message();
+  j["waits"] = Json::array();  // each sample that did not extend it, and why
+  for (const auto& [sample, why] : waits_) j["waits"].push_back({{"sample", sample}, {"why", why}});
   return j;
 }
 

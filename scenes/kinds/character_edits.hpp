@@ -162,6 +162,8 @@ class TearRun {
   const PlacedTear at_;
   const BindPose& bind_;
   int next_ = 0, extended_ = 0;
+  // The samples after the first that left the tear as it was, with the tear's reason.
+  std::vector<std::pair<int, std::string>> waits_;
   double tip_to_blade_ = -1;  // the tip's distance from the last sample's blade, m
   std::string bone_;
 };

@@ -131,7 +131,7 @@ Json FallingPieces::release_severed(bullet::SkinnedSoftBody& body, double volume
     const double size = extent(piece);
     if (ground) ground->fit_contact_grid(size);
     // A contact margin of at most a twentieth of the piece: the scenes' 5 mm crushed a 2 mm
-    // piece of a 3.7 cm model (WusonSMD.smd at 100 units per metre) inside out.
+    // piece of a 3.7 cm model (WusonSMD.smd taken at 100 units a metre) inside out.
     btCollisionShape& shape = *body.piece_body(p.id)->getCollisionShape();
     shape.setMargin(std::min(shape.getMargin(), btScalar(size / 20)));
     const double volume = closed(piece) ? double(piece.getVolume()) : 0.0;

@@ -1,6 +1,7 @@
 #include "kinds/model_frame.hpp"
 
 #include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
 #include <numbers>
 #include <stdexcept>
 
@@ -43,6 +44,17 @@ void to_scene_frame(io::SkinnedModel& model, const ModelFrame& frame) {
   for (Eigen::Index c = 0; c < corners.cols(); ++c)
     for (int k = 0; k < 3; ++k)
       corners.col(c).segment<3>(3 * k) = r * corners.col(c).segment<3>(3 * k);
+}
+
+FileUnits file_units(const io::SkinnedModel& model, const std::string& file) {
+  if (model.unit_scale_cm <= 0)
+    return {1, "assumed: metres (the file states no unit; set model.units_per_metre)"};
+  const std::string cm = nlohmann::json(model.unit_scale_cm).dump();
+  const double units = 100 / model.unit_scale_cm;
+  if (!(units >= 1e-6 && units <= 1e6))
+    throw std::runtime_error(file + ": its UnitScaleFactor " + cm +
+                             " cm is out of range; set model.units_per_metre");
+  return {units, "the file's UnitScaleFactor (" + cm + " cm)"};
 }
 
 }  // namespace conform::scenes

@@ -75,7 +75,8 @@ TEST(CharacterUnits, AModelInMillimetresRuns) {
 
 TEST(CharacterUnits, TheUnitTheFileStatesIsTheDefault) {
   // FBX files state their unit (UnitScaleFactor, centimetres per unit): huesitos.fbx's is 1 cm.
-  // An .X file states none: 100 units per metre, as the scene always assumed.
+  // An .X file states none: metres, assumed (glTF's unit and Bullet's; BCN_Epileptic.X is a
+  // 1.8 m human in it), and the summary says it is assumed.
   if (!fs::exists(kModels + "FBX/huesitos.fbx")) GTEST_SKIP() << "no assimp-testmodels";
   const Outcome fbx = run("--steps 2" + kNoEdits, "units_fbx");
   ASSERT_EQ(fbx.rc, 0) << fbx.log;
@@ -86,7 +87,7 @@ TEST(CharacterUnits, TheUnitTheFileStatesIsTheDefault) {
   const Outcome x =
       run("--steps 2" + kNoEdits + "--set model.file=" + kModels + "X/anim_test.x", "units_x");
   ASSERT_EQ(x.rc, 0) << x.log;
-  EXPECT_EQ(x.summary["metrics"]["units_per_metre"].get<double>(), 100);
+  EXPECT_EQ(x.summary["metrics"]["units_per_metre"].get<double>(), 1);
   EXPECT_NE(x.summary["metrics"]["units_per_metre_from"].get<std::string>().find("assumed"),
             std::string::npos);
   const Outcome set = run("--steps 2" + kNoEdits + "--set model.units_per_metre=250", "units_set");
@@ -161,7 +162,7 @@ TEST(CharacterBindPose, AModelWithoutAnimationPlaysItsBindPose) {
 
 TEST(CharacterCutRegion, AnArmCutSeversTheArmOnly) {
   // A level plane through BCN_Epileptic.X's right forearm (it hangs by the body) also crosses
-  // the left arm and the torso's layers: unbounded, it cuts them all; bounded to the section
+  // the left arm and the torso: unbounded, it cuts them all (3 loops); bounded to the section
   // nearest the cut's point (the default, cut.region = "nearest"), one loop, around the arm.
   const std::string file = kModels + "X/BCN_Epileptic.X";
   if (!fs::exists(file)) GTEST_SKIP() << "no assimp-testmodels";
@@ -183,8 +184,8 @@ TEST(CharacterCutRegion, AnArmCutSeversTheArmOnly) {
   ASSERT_EQ(plane.rc, 0) << plane.log;
   const Json& all = plane.summary["metrics"]["cut"];
   EXPECT_EQ(all["region"], "everywhere");
-  EXPECT_GT(all["loops"].get<int>(), 3) << all;
-  EXPECT_GT(all["new_pieces"].get<int>(), 3) << all;
+  EXPECT_GE(all["loops"].get<int>(), 3) << all;
+  EXPECT_GE(all["new_pieces"].get<int>(), 3) << all;
   // Another name is refused, naming it.
   const Outcome bad = run("--steps 2" + kNoEdits + "--set cut.region=arm", "region_bad");
   EXPECT_NE(bad.rc, 0);

@@ -87,6 +87,8 @@ TEST(CharacterPlacement, TheThreeEditsLandOnRealModelsWithTheDefaults) {
   };
   const Case cases[] = {{"FBX/huesitos.fbx", true, 0.6},
                         {"FBX/animation_with_skeleton.fbx", true, 0.8},
+                        {"X/BCN_Epileptic.X", true, 0.9},
+                        {"X/Testwuson.X", true, 0.8},
                         {"X/anim_test.x", true, 0.8},
                         {"SMD/WusonSMD.smd", true, 0.7},
                         {"glTF2/simple_skin/simple_skin.gltf", false, 0.8}};

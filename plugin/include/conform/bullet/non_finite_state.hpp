@@ -6,7 +6,9 @@
 // Bullet's solve, and this substep's motion prediction (so the drive never reads a NaN). What
 // the last substep of a stepSimulation leaves is seen at the start of the next one;
 // SkinnedSoftBody::first_non_finite_node() asks at any time. The same pass stops a runaway: a
-// node faster than the body's Material::max_speed (its velocity finite but unphysical).
+// node moving faster than the body's Material::max_speed past its skinned target (its own
+// velocity less the target's over the last substep; a released piece's whole velocity): finite
+// but unphysical. A skin the animation itself sweeps fast is not a runaway.
 // The exception leaves stepSimulation mid-step; the world's state is then only fit for
 // inspection and teardown.
 #pragma once
@@ -26,7 +28,7 @@ struct NonFiniteNode {
   int node = -1;             // the node's index in the piece's btSoftBody
   std::int32_t vertex = -1;  // the mesh vertex it mirrors
   bool position = true;      // position (m_x) non-finite, else velocity (m_v)
-  bool runaway = false;      // the velocity is finite but faster than Material::max_speed
+  bool runaway = false;      // finite, but faster than Material::max_speed past its target
   Eigen::Vector3d value = Eigen::Vector3d::Zero();
 };
 

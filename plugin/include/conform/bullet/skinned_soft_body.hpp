@@ -114,8 +114,9 @@ struct Material {
   double bending_stiffness = 0.0;
   /// Collision margin of the pieces, m.
   double margin = 0.005;
-  /// A node faster than this, in the world's length unit per second, is a runaway: the plugin
-  /// stops the step with bullet::NonFiniteState naming it, as it does for a NaN (an unstable
+  /// A node faster than this past its skinned target (its velocity less the target's; a
+  /// released piece's whole velocity), in the world's length unit per second, is a runaway: the
+  /// plugin stops the step with bullet::NonFiniteState naming it, as it does for a NaN (an unstable
   /// integration often grows for many steps before it overflows, writing finite garbage). > 0.
   /// The default, infinity, turns the check off, since the plugin does not know the world's
   /// unit; the scenes (in metres) set 100 m/s, far above any motion of a body's skin.
