@@ -92,6 +92,16 @@ struct RunState {
   double edit_ms = 0, physics_ms = 0;
   FallingPieces falling;     // the pieces the cut severs (cut.release)
   Ground* ground = nullptr;  // what they fall onto (ground.enabled)
+  // The membrane's solve, sampled at each step's last substep.
+  long newton_sum = 0, cg_sum = 0;
+  int newton_max = 0, unconverged = 0;
+  double worst_relative_residual = 0;
+  void tally(const membrane::SolveReport& r) {
+    newton_sum += r.newton_iterations, cg_sum += r.cg_iterations;
+    newton_max = std::max(newton_max, r.newton_iterations);
+    unconverged += !r.converged;
+    worst_relative_residual = std::max(worst_relative_residual, r.relative_residual);
+  }
 };
 
 // The tear's physical opening against its geometric copy, with the largest of each so far.
@@ -228,6 +238,7 @@ class Character final : public Scene {
       const auto tp = Clock::now();
       w.step();
       s.physics_ms += std::chrono::duration<double, std::milli>(Clock::now() - tp).count();
+      if (material_.model == bullet::MaterialModel::membrane) s.tally(body.last_solve());
       if (step == 1) s.first = first_step(body, start_targets, c.dt);
       const auto te = Clock::now();
       edit(body, bind, tear, compare ? &*compare : nullptr, step * c.dt, s);
@@ -241,6 +252,13 @@ class Character final : public Scene {
     if (!finite_nodes(body)) throw std::runtime_error("the soft body blew up (non-finite nodes)");
     if (tear_.enabled) s.tear = tear.summary(body);
     Json metrics = summarize(body, model, animation, weld, seams, bind, kinematic, c, s);
+    if (material_.model == bullet::MaterialModel::membrane)
+      metrics["solver"] = {{"sampled", "each step's last substep"},
+                           {"newton_mean", double(s.newton_sum) / c.steps},
+                           {"newton_max", s.newton_max},
+                           {"cg_mean", double(s.cg_sum) / c.steps},
+                           {"unconverged_steps", s.unconverged},
+                           {"worst_relative_residual", s.worst_relative_residual}};
     Json timings = {{"model_vertices", model.mesh.vertex_count()},
                     {"physics_ms_per_step", s.physics_ms / c.steps},
                     {"edits_ms", s.edit_ms}};

@@ -35,6 +35,12 @@ TEST(SceneCharacterMembrane, FollowsTheAnimationAtLeastAsCloselyAsTheLinks) {
   // The wound opens like the geometric one, not by metres.
   EXPECT_LT(membrane["physics"]["max_opening"].get<double>(),
             3 * membrane["geometric"]["max_opening"].get<double>());
+  // Every step's solve converged to the material's relative tolerance; the links have none.
+  const Json& solve = membrane["solver"];
+  EXPECT_EQ(solve["unconverged_steps"].get<int>(), 0) << solve;
+  EXPECT_LE(solve["worst_relative_residual"].get<double>(), 1.2e-3) << solve;
+  EXPECT_GE(solve["newton_mean"].get<double>(), 1) << solve;  // the animation moves it
+  EXPECT_FALSE(links.contains("solver"));
 }
 
 }  // namespace
