@@ -141,10 +141,11 @@ Json FallingPieces::release_severed(bullet::SkinnedSoftBody& body, double volume
     // Bullet's contacts with static bodies take kKHR (0.1 by default) of the penetration per
     // iteration: a resting piece sank 8 mm into the ground (13 mm past its margin) on huesitos.
     body.piece_body(p.id)->m_cfg.kKHR = 1;
-    // A membrane body runs with Bullet's kDP = 0 (its damping is the membrane's), and its
-    // released piece kept it: undamped, huesitos' severed limb bounced and sank through the
-    // ground. With a ground, the links' damping at least (the character's 0.01 lands it within
-    // 1 mm); kDP damps the fall too, so a piece without ground falls freely.
+    // A membrane body runs with Bullet's kDP = 0 (its damping is the membrane's). Undamped, in
+    // either skin, huesitos' severed limb keeps the spin it lands with, and a node driven deep
+    // into the ground loses its contact there: the piece falls through (docs/scenes.md). With a
+    // ground, the links' damping at least (0.01 lands it within 1 mm); kDP damps the fall too,
+    // so a piece without ground falls freely.
     btScalar& damping = body.piece_body(p.id)->m_cfg.kDP;
     if (ground) damping = std::max(damping, btScalar(0.01));
     if (ground)
