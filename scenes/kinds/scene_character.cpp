@@ -102,6 +102,14 @@ struct RunState {
     unconverged += !r.converged;
     worst_relative_residual = std::max(worst_relative_residual, r.relative_residual);
   }
+  Json solver(int steps) const {
+    return {{"sampled", "each step's last substep"},
+            {"newton_mean", double(newton_sum) / steps},
+            {"newton_max", newton_max},
+            {"cg_mean", double(cg_sum) / steps},
+            {"unconverged_steps", unconverged},
+            {"worst_relative_residual", worst_relative_residual}};
+  }
 };
 
 // The tear's physical opening against its geometric copy, with the largest of each so far.
@@ -216,13 +224,7 @@ class Character final : public Scene {
       start_targets[static_cast<std::size_t>(v)] = body.target(v);
     std::int32_t kinematic = 0;
     for (std::int32_t v = 0; v < body.vertex_count(); ++v) kinematic += body.kinematic(v);
-    std::vector<std::string> columns{"t",      "offset_mean_m", "offset_max_m", "seam_gap_rel",
-                                     "pieces", "nodes"};
-    if (releases()) columns.push_back("released_lowest_m");
-    if (compare)
-      columns.insert(columns.end(), {"physics_max_opening", "geometric_max_opening", "physics_area",
-                                     "geometric_area"});
-    out.open_metrics(columns);
+    out.open_metrics(metrics_columns(compare.has_value()));
     if (compare) compare->profiles.open_history(out);
     std::optional<Ground> ground;
     if (ground_.enabled) {
@@ -252,13 +254,7 @@ class Character final : public Scene {
     if (!finite_nodes(body)) throw std::runtime_error("the soft body blew up (non-finite nodes)");
     if (tear_.enabled) s.tear = tear.summary(body);
     Json metrics = summarize(body, model, animation, weld, seams, bind, kinematic, c, s);
-    if (material_.model == bullet::MaterialModel::membrane)
-      metrics["solver"] = {{"sampled", "each step's last substep"},
-                           {"newton_mean", double(s.newton_sum) / c.steps},
-                           {"newton_max", s.newton_max},
-                           {"cg_mean", double(s.cg_sum) / c.steps},
-                           {"unconverged_steps", s.unconverged},
-                           {"worst_relative_residual", s.worst_relative_residual}};
+    if (material_.model == bullet::MaterialModel::membrane) metrics["solver"] = s.solver(c.steps);
     Json timings = {{"model_vertices", model.mesh.vertex_count()},
                     {"physics_ms_per_step", s.physics_ms / c.steps},
                     {"edits_ms", s.edit_ms}};
@@ -280,6 +276,17 @@ class Character final : public Scene {
   }
 
  private:
+  // metrics.csv's columns, in the order measure() writes them.
+  std::vector<std::string> metrics_columns(bool compare) const {
+    std::vector<std::string> columns{"t",      "offset_mean_m", "offset_max_m", "seam_gap_rel",
+                                     "pieces", "nodes"};
+    if (releases()) columns.push_back("released_lowest_m");
+    if (compare)
+      columns.insert(columns.end(), {"physics_max_opening", "geometric_max_opening", "physics_area",
+                                     "geometric_area"});
+    return columns;
+  }
+
   // The file's units: model.units_per_metre, else the file's own (model_frame.hpp).
   ModelFrame frame_of(const io::SkinnedModel& model) {
     ModelFrame frame = frame_;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <initializer_list>
 #include <random>
 #include <string>
 
@@ -78,6 +79,14 @@ Json run_model(const std::string& file, const std::string& tag, const std::strin
   return r.summary.is_object() ? r.summary["metrics"] : Json();
 }
 
+// The character scene run with `args` fails, and its message names each of `names`.
+void expect_refused_naming(const std::string& args, const std::string& tag,
+                           std::initializer_list<const char*> names) {
+  const conform::test::CommandRun bad = conform::test::run_conform_scene("character", args, tag);
+  EXPECT_NE(bad.rc, 0);
+  for (const char* name : names) EXPECT_NE(bad.log.find(name), std::string::npos) << bad.log;
+}
+
 TEST(CharacterPlacement, TheThreeEditsLandOnRealModelsWithTheDefaults) {
   // Each model as imported, the membrane and every placement at its defaults.
   struct Case {
@@ -122,23 +131,16 @@ TEST(CharacterPlacement, ANamedBoneAimsEveryEditAtItsLimb) {
                            "--set drill.bone=Bone.003 --set tear.side=inner");
   ASSERT_TRUE(m.is_object());
   for (const char* edit : {"cut", "tear", "drill"}) EXPECT_EQ(m[edit]["limb"], "Bone.003") << edit;
-  const conform::test::CommandRun bad = conform::test::run_conform_scene(
-      "character",
+  expect_refused_naming(
       "--steps 2 --set cut.at=0 --set tear.enabled=false --set drill.enabled=false "
       "--set cut.bone=Femur",
-      "placement_bad_bone");
-  EXPECT_NE(bad.rc, 0);
-  EXPECT_NE(bad.log.find("cut.bone"), std::string::npos) << bad.log;
-  EXPECT_NE(bad.log.find("Femur"), std::string::npos) << bad.log;
+      "placement_bad_bone", {"cut.bone", "Femur"});
 }
 
 TEST(CharacterPlacement, TheBoxsKeysNeedTheirPoint) {
   // A box key without its point is refused by name; with the point the edit is in the box.
-  const conform::test::CommandRun bad = conform::test::run_conform_scene(
-      "character", "--steps 2 --set cut.normal=[0,1,0]", "placement_box_bad");
-  EXPECT_NE(bad.rc, 0);
-  EXPECT_NE(bad.log.find("cut.normal"), std::string::npos) << bad.log;
-  EXPECT_NE(bad.log.find("cut.point"), std::string::npos) << bad.log;
+  expect_refused_naming("--steps 2 --set cut.normal=[0,1,0]", "placement_box_bad",
+                        {"cut.normal", "cut.point"});
   const std::string file = kModels + "FBX/huesitos.fbx";
   if (!fs::exists(file)) GTEST_SKIP() << "no assimp-testmodels";
   const Json m = run_model(file, "placement_box",
