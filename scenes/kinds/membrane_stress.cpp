@@ -1,7 +1,7 @@
 #include "kinds/membrane_stress.hpp"
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/QR>
+#include <Eigen/Geometry>
+#include <cmath>
 
 #include "conform/membrane/detail/cst_kernel.hpp"
 #include "conform/membrane/model.hpp"
@@ -12,15 +12,21 @@ namespace conform::scenes {
 Eigen::Vector2d principal_cauchy_stresses(const Eigen::Matrix<double, 3, 2>& f,
                                           const Eigen::Matrix2d& pk2) {
   const Eigen::Matrix3d cauchy = f * pk2 * f.transpose();
-  // An orthonormal basis of the deformed face's plane (F's columns span it): the stress has no
-  // component along the normal, whose eigenvalue 0 is not a principal stress of the sheet.
-  const Eigen::Matrix<double, 3, 2> plane =
-      f.householderQr().householderQ() * Eigen::Matrix<double, 3, 2>::Identity();
-  const Eigen::Matrix2d in_plane = plane.transpose() * cauchy * plane;
-  const Eigen::Vector2d ascending =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(in_plane, Eigen::EigenvaluesOnly)
-          .eigenvalues();
-  return {ascending(1), ascending(0)};
+  // An orthonormal basis (e1, e2) of the deformed face's plane, which F's columns span
+  // (Gram-Schmidt from the longer one): the stress has no component along the normal, whose
+  // eigenvalue 0 is not a principal stress of the sheet. A collapsed F spans less; any unit
+  // vectors complete it, as its stress is 0 along them.
+  const bool first_longer = f.col(0).squaredNorm() >= f.col(1).squaredNorm();
+  const Eigen::Vector3d a = first_longer ? f.col(0) : f.col(1);
+  const Eigen::Vector3d b = first_longer ? f.col(1) : f.col(0);
+  const Eigen::Vector3d e1 =
+      a.norm() > 0 ? Eigen::Vector3d(a.normalized()) : Eigen::Vector3d::UnitX();
+  Eigen::Vector3d e2 = b - e1.dot(b) * e1;
+  e2 = e2.norm() > 1e-12 * a.norm() ? Eigen::Vector3d(e2.normalized()) : e1.unitOrthogonal();
+  // The eigenvalues of the symmetric [[p, q], [q, r]]: (p + r)/2 +- hypot((p - r)/2, q).
+  const double p = e1.dot(cauchy * e1), q = e1.dot(cauchy * e2), r = e2.dot(cauchy * e2);
+  const double mean = (p + r) / 2, radius = std::hypot((p - r) / 2, q);
+  return {mean + radius, mean - radius};
 }
 
 Eigen::Matrix2Xd vertex_principal_stresses(const mesh::SkinnedMesh& mesh,

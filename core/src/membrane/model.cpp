@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "conform/membrane/detail/cst_kernel.hpp"
+
 namespace conform::membrane {
 namespace {
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "active_system.hpp"
+#include "conform/membrane/detail/cst_kernel.hpp"
 #include "conform/membrane/solver.hpp"
 
 namespace conform::membrane {

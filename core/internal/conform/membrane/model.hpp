@@ -14,7 +14,7 @@
 #include <span>
 #include <vector>
 
-#include "conform/membrane/detail/cst_kernel.hpp"
+#include "conform/membrane/detail/element_rest.hpp"
 #include "conform/membrane/skin_material.hpp"
 #include "conform/mesh/skinned_mesh.hpp"
 
