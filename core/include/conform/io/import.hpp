@@ -1,35 +1,11 @@
 // Loading rigged models: any format assimp reads (.dae, .fbx, .gltf/.glb, .x, .smd,
-// .md5mesh, ...) or the built-in procedural arm ("arm", "arm:N").
-//
-// Import conventions:
-// - assimp post-processing: triangulate, join identical vertices, validate the data
-//   structure (import_flags()); no weight limiting — every influence is kept.
-// - Every node of the scene becomes a joint (depth-first, parents first), with its own
-//   transform as a versor; every aiBone becomes a bone on the node of the same name. A mesh
-//   without bones becomes one rigid bone on its node. A bone without a node of its name gets a
-//   root joint of its own at its bind pose (O⁻¹), with a warning. A mesh placed by several
-//   nodes is imported once per node (MeshInfo::source names the file's mesh).
-// - Exact bind transforms: at the rest pose the model reproduces the file's matrix skinning
-//   x' = Σ w G_b O_b x (G_b the bone node's global matrix, O_b its offset). Each mesh's bind
-//   transform K = Q N: Q, the nearest proper similarity, is carried by the versors; N, the
-//   non-uniform stretch or mirror, is baked into the rest positions, x_rest = N x (normals by
-//   N⁻ᵀ, faces rewound when N mirrors; nothing is baked when K is a similarity). Mirroring
-//   nodes and bones below approximated nodes stay exact too. Not exact: a non-uniform scale
-//   that an animation really moves (animated, or above an animated bone), or a key that
-//   changes a node's parity. There the nearest similarity is used, and the importer warns with
-//   the largest deviation from the file's matrix skinning (at the rest pose and every key
-//   time) relative to the model's diagonal. Derivation: docs/notes/import_skinning_ik.md.
-// - Influences: all kept (SkinnedModel::influences). Each vertex's weights are normalized to
-//   sum 1; sums off by more than 1e-4 (exports that truncate influences) give one summary
-//   warning, or with ImportOptions::strict_weights an error. A vertex whose bones give it no
-//   weight is an error.
-// - Animations: position, rotation and scaling keys per node channel, times in ticks;
-//   ticks per second 25 when the file says 0.
-// - Welding (ImportOptions::weld, on by default): each mesh's vertices at one position become
-//   one vertex; UVs and normals are kept per face corner (SkinnedMesh::corner_uvs/normals).
-// - Errors (missing file, unsupported format, unreadable or truncated file, no meshes, NaN
-//   transforms or keys, strict weights not summing to 1, bone or vertex ids out of range)
-//   throw ImportError whose message starts with the file name.
+// .md5mesh, ...) or the built-in procedural arm ("arm", "arm:N"). Every node becomes a joint
+// and every influence is kept, with each vertex's weights normalized; at the rest pose the
+// model reproduces the file's matrix skinning exactly, except where an animation moves a
+// non-uniform scale or changes a node's parity, and there the importer warns with the
+// deviation. Welding (ImportOptions::weld, on by default) merges each mesh's vertices at one
+// position. Errors throw ImportError, whose message starts with the file name. The conventions
+// in full: docs/notes/import_skinning_ik.md, "Import conventions (io/import.hpp)".
 #pragma once
 
 #include <filesystem>

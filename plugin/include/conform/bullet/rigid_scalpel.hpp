@@ -1,37 +1,12 @@
 // A scalpel held by a Bullet rigid body: its blade (a segment fixed in the body's local
-// frame) becomes tear samples of one SkinnedSoftBody, with the spacing handled here.
-//
-//   btRigidBody blade_body(...);                       // kinematic or dynamic, in the world
-//   conform::bullet::RigidScalpel scalpel(skin, blade_body, {0, 0, 0.02}, {0, 0, -0.02});
-//   for (;;) {
-//     world.stepSimulation(1.0 / 60);
-//     scalpel.update(plugin.time());                   // between steps, like every edit
-//   }
-//
-// Why the spacing matters. Every tear sample puts the tear's tip where the blade crosses the
-// surface (tear.hpp). A sample whose blade is still in the old tip's fan of thin faces is
-// refused (the tip would halve a thin corner) and waits for the blade to move on, so a blade
-// that moves a small fraction of the local edge per frame extends the tear only in some
-// samples and, when it does, by a step much shorter than the faces it cuts; one that jumps
-// several edges per frame leaves the faces in between to one long step (bounded by the
-// region the blade swept). Spacing the samples as below gives the same tear with far fewer
-// samples and path points (figures: docs/notes/plugin.md).
-//
-// What update() does with the blade's motion since the previous call (taken as linear: the
-// end points move on straight lines):
-//   - sub-samples it so that no sample moves the blade more than max_advance × h from the
-//     previous sample, h being the mean length of the edges at the tear's tip (before the
-//     tear starts, of the mesh), so every face the blade sweeps is reached;
-//   - submits a sample only once the blade is at least min_advance × h from the tip and no
-//     longer crosses a face around the tip (accumulating the motion until then), so the new
-//     tip lands outside the old tip's fan of thin faces. The tip thus lags the blade by at
-//     most about one face; a blade that stops inside the tip's faces leaves the tear there.
-// Until the tear has started, every sub-sample is submitted (the first that meets the
-// surface starts it). The blade's end points are in the rigid body's local frame; samples
-// are in world space (as SkinnedSoftBody's tear_advance takes them).
-//
-// Lifetime: the scalpel refers to the skinned body and the rigid body, which must outlive
-// it; it begins its own tear (begin_tear) at the first update. Threading: as every edit.
+// frame) becomes tear samples of one SkinnedSoftBody, with the spacing handled here. update(),
+// called between steps, sub-samples the blade's motion since the previous call so that every
+// face it sweeps is reached, and submits a sample only once the blade has left the tip's fan of
+// thin faces (where the tear would refuse it): the same tear with far fewer samples and path
+// points. Lifetime: the skinned body and the rigid body must outlive the scalpel; it begins its
+// own tear at the first update. Threading: as every edit. A usage example, update()'s rules
+// and why the spacing matters: docs/notes/plugin.md, "Using the rigid scalpel
+// (rigid_scalpel.hpp)".
 #pragma once
 
 #include <LinearMath/btVector3.h>

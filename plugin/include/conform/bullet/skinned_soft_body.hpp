@@ -1,36 +1,12 @@
-// A Bullet soft body whose skinning path is CGA motor skinning (eq 17), and whose topology
-// changes at run time (cut, tear, drill) while it simulates.
-//
-// Mesh ↔ Bullet: nodes = vertices, links = edges of faces (the body's material 0), faces =
-// triangles, and optional bending links (material 1) joining the two vertices opposite each
-// edge shared by two faces. Every connected piece of the mesh is its own btSoftBody (Bullet's
-// face tree never returns on a body whose faces are not edge-connected).
-//
-// Promises:
-//   - edits conserve mass and momentum exactly. A vertex left without faces (the inside of a
-//     drilled hole) is detached: it leaves Bullet (no node, link, collision or solver work);
-//     its mass stays in the books (total_mass(), momentum()) as the removed material's, with
-//     its state at the edit, and from the next substep on it rides its skinned target;
-//   - vertex indices never change after an edit (face indices do, see topology_version()).
-//     Vertices are never reclaimed (a documented bound instead of compaction): the arrays grow
-//     by exactly the new vertices of each change, and the only unused ones are the detached
-//     insides of drilled holes, each costing its per-vertex arrays and its skinning every
-//     substep, no Bullet work;
-//   - an edit costs time proportional to the change, and never triggers Bullet's whole-body
-//     reset (m_bUpdateRtCst).
-//
-// How: an edit removes nodes, links and faces by swap-with-last with local re-pointing, and
-// writes the link constants, rest lengths and face areas of what changed itself; a split is
-// found by searches from the changed vertices that stop once all but one of them are exhausted,
-// and only the exhausted (smaller) side moves into a new btSoftBody. Each substep (in the
-// plugin's action, after Bullet's motion prediction, before its constraint solve) skins the
-// pose source's pose to one target per vertex and places the kinematic nodes on theirs (Bullet
-// inverse mass 0, velocity (target − previous) / dt). With the membrane (the default) the free
-// nodes then take one backward-Euler step of the skin membrane (last_solve()), Bullet's links
-// are inert (c0 = 0) and its contacts act on the result; with bullet_links an implicit
-// spring–damper per node pulls them toward their targets, and every link's rest length is
-// re-applied from our own copy (Bullet resets rest lengths to the current lengths after any
-// edit, which would wipe pretension). Figures: docs/notes/plugin.md.
+// A Bullet soft body skinned by CGA motor skinning (eq 17) whose topology changes at run time
+// (cut, tear, drill) while it simulates: nodes = vertices, links = face edges, faces =
+// triangles, one btSoftBody per connected piece. Promises: edits conserve mass and momentum
+// exactly (a vertex left without faces leaves Bullet but stays in the books); vertex indices
+// never change (face indices do, see topology_version()); an edit costs time proportional to
+// the change and never resets the whole body. Each substep skins one target per vertex and
+// drives the nodes toward theirs, by the skin membrane (default) or by Bullet's links. The
+// mapping, the promises in full, how edits and substeps work, and why: docs/notes/plugin.md,
+// "The skinned soft body's design (skinned_soft_body.hpp)".
 #pragma once
 
 #include "conform/bullet/precision.hpp"  // the package's Bullet precision, checked
