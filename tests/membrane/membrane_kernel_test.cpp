@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <random>
 
+#include "conform/membrane/detail/cst_kernel.hpp"
 #include "conform/membrane/model.hpp"
 
 namespace conform::membrane {

@@ -6,6 +6,7 @@
 
 #include <random>
 
+#include "conform/membrane/detail/cst_kernel.hpp"
 #include "conform/membrane/model.hpp"
 
 namespace conform::membrane {

@@ -9,6 +9,7 @@
 #include <array>
 #include <random>
 
+#include "conform/membrane/detail/cst_kernel.hpp"
 #include "conform/membrane/model.hpp"
 
 namespace conform::membrane {
