@@ -38,12 +38,14 @@ bool TearAdvance::split_along_path() {
     for (std::size_t i = 0; i < path_.size(); ++i) {
       Crossing& c = path_[i];
       if (c.out.kind == PathPoint::Inside && !place_new_tip(c)) {
-        // No room inside the face for a tip: on the edge crossing behind the blade, however
-        // far, or else on the one ahead, where that makes no sliver.
+        // No room inside the face for a tip. The lips: on the edge crossing behind the blade,
+        // however far, or else on the one ahead, where that makes no sliver. Otherwise the
+        // face is in the old tip's fan: on the track's edge ahead or behind (past the fan).
         const std::string message = tear_.message_;
         path_.back().out = blade;
         off_track_ = false;
         if (smooth && split_with_tip_on_edge(std::numeric_limits<double>::infinity(), true)) break;
+        if (!smooth && split_with_tip_past_fan()) break;
         tear_.message_ = message;
         return false;
       }

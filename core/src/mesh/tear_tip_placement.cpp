@@ -101,7 +101,12 @@ bool TipPlacement::split_with_recovered_edges(bool on_edge, double lambda) {
   return true;
 }
 
-bool TipPlacement::split_with_tip_on_edge(double behind, bool ahead) {
+bool TipPlacement::split_with_tip_past_fan() {
+  const double inf = std::numeric_limits<double>::infinity();
+  return split_with_tip_on_edge(0, true, true) || split_with_tip_on_edge(inf, false, true);
+}
+
+bool TipPlacement::split_with_tip_on_edge(double behind, bool ahead, bool past_fan) {
   const Crossing& last = path_.back();
   if (last.out.kind != PathPoint::Inside) return false;
   const Eigen::Vector3d hit = pos(last.out, last.face);
@@ -115,7 +120,7 @@ bool TipPlacement::split_with_tip_on_edge(double behind, bool ahead) {
   // vertex on the path, a lip that doubles back. Past an edge crossing, the blade's face is
   // split from its vertex opposite that edge, which needs a roomy face.
   const bool at_vertex = near && last.in.kind == PathPoint::Vertex;
-  if (!at_vertex && !roomy(last.face)) return false;
+  if (!at_vertex && !past_fan && !roomy(last.face)) return false;
   if (near) {
     tip = last.in;
     if (!at_vertex) beyond = last.face;
@@ -144,7 +149,16 @@ bool TipPlacement::split_with_tip_on_edge(double behind, bool ahead) {
       return false;
     split_from_opposite(beyond, tip);
   }
-  const double floor2 = std::pow(std::sin(tear_.options_.min_angle), 2);
+  // Past a fan the faces made must be as roomy as the blade's face (up to twice the floor): a
+  // later split of one keeps what a split of that face would have kept.
+  const double min_angle = tear_.options_.min_angle;
+  const Face& blade_face = mesh_.faces[static_cast<std::size_t>(path_.back().face)];
+  const double kept =
+      past_fan ? std::clamp(smallest_angle(position_of(blade_face[0]), position_of(blade_face[1]),
+                                           position_of(blade_face[2])),
+                            min_angle, 2 * min_angle)
+               : min_angle;
+  const double floor2 = std::pow(std::sin(kept), 2);
   for (std::size_t i = first_checked; i < split_.added_faces.size(); ++i) {
     const Face& f = split_.added_faces[i];
     if (smallest_angle_sin2(position_of(f[0]), position_of(f[1]), position_of(f[2])) < floor2)

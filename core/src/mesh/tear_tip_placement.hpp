@@ -43,9 +43,18 @@ class TipPlacement : public PathSplit {
   // vertex; the tip lags the blade by at most that much. With `ahead`, a hit too far from the
   // crossing (or one in a face beside the tip) puts the tip where Π leaves the blade's face
   // instead, and splits the face beyond. False (nothing kept) when neither applies or the
-  // faces it makes would be thinner than min_angle.
+  // faces it makes would be thinner than min_angle. `past_fan` (split_with_tip_past_fan) lets
+  // the blade's face be thinner than roomy() asks, but then every face made must be roomy.
   static constexpr double kLipBehind = 0.4;
-  bool split_with_tip_on_edge(double behind, bool ahead = false);
+  bool split_with_tip_on_edge(double behind, bool ahead = false, bool past_fan = false);
+
+  // Where the blade is in a face the tear made (the old tip's fan) too thin for a tip inside
+  // it, the tip goes on an edge of the track instead: where Π leaves that face ahead of
+  // the hit (the face beyond split from its vertex opposite), or else on the edge crossing
+  // behind the hit. Each face it makes keeps twice min_angle, so that a later split keeps the
+  // floor; nothing moves off the track and nothing is flipped, so the area is the faces' own.
+  // False (nothing kept) when neither fits.
+  bool split_with_tip_past_fan();
 
  private:
   // One placement of the tip on the blade's track: true when it made the split.
