@@ -125,7 +125,8 @@ double StepPlane::mean_edge(std::int32_t face) const {
   return sum / 3;
 }
 
-bool StepPlane::exit_ahead(const Crossing& c, const Eigen::Vector3d& hit, PathPoint& out) const {
+bool StepPlane::exit_ahead(const Crossing& c, const Eigen::Vector3d& hit, PathPoint& out,
+                           double slack, bool through_vertex) const {
   const Face& f = mesh_.faces[static_cast<std::size_t>(c.face)];
   const Eigen::Vector3d from = pos(c.in, c.face);
   for (int corner = 0; corner < 3; ++corner) {
@@ -133,8 +134,9 @@ bool StepPlane::exit_ahead(const Crossing& c, const Eigen::Vector3d& hit, PathPo
     if (on_edge(c.in, x, y) || (c.in.kind == PathPoint::Vertex && (c.in.v == x || c.in.v == y)))
       continue;
     PathPoint e;
-    if (!exit_opposite(c.face, corner, e) || e.kind != PathPoint::Edge) continue;
-    if ((pos(e, c.face) - hit).dot(hit - from) <= 0) continue;
+    if (!exit_opposite(c.face, corner, e)) continue;
+    if (e.kind != PathPoint::Edge && !(through_vertex && e.kind == PathPoint::Vertex)) continue;
+    if ((pos(e, c.face) - hit).dot((hit - from).normalized()) <= -slack) continue;
     out = e;
     return true;
   }

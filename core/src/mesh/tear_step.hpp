@@ -129,9 +129,11 @@ class StepPlane {
     return smallest_angle(mesh_.current.col(f[0]), mesh_.current.col(f[1]),
                           mesh_.current.col(f[2])) >= 2 * tear_.options_.min_angle;
   }
-  // Where Π leaves the blade's face (crossing c) ahead of the hit, on an edge other than the
-  // one it came in by: false if there is none (or Π leaves it through a vertex).
-  bool exit_ahead(const Crossing& c, const Eigen::Vector3d& hit, PathPoint& out) const;
+  // Where Π leaves the blade's face (crossing c) ahead of the hit (or behind it by at most
+  // `slack`, m), on an edge other than the one it came in by: false if there is none, or if Π
+  // leaves it through a vertex and `through_vertex` is false.
+  bool exit_ahead(const Crossing& c, const Eigen::Vector3d& hit, PathPoint& out, double slack = 0,
+                  bool through_vertex = false) const;
 
   TearState tear_;
   SkinnedMesh& mesh_;

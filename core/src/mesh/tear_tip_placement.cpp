@@ -125,12 +125,17 @@ bool TipPlacement::split_with_tip_on_edge(double behind, bool ahead, bool past_f
     tip = last.in;
     if (!at_vertex) beyond = last.face;
     path.pop_back();  // the path ends at the tip
-  } else if (ahead && exit_ahead(last, hit, tip)) {
+  } else if (ahead &&
+             exit_ahead(last, hit, tip, past_fan ? snap_ * mean_edge(last.face) : 0, past_fan)) {
     path.back().out = tip;
-    const std::int32_t e = adjacency_.find(tip.a, tip.b), g = adjacency_.find(tip.b, tip.a);
-    const std::int32_t o = e >= 0 && e / 3 == last.face ? g : e;
-    if (o < 0) return false;  // a boundary edge
-    beyond = o / 3;
+    if (tip.kind == PathPoint::Vertex) {  // past a fan: the tip on that vertex, nothing beyond
+      if (on_border(last.face, corner_of(last.face, tip.v))) return false;
+    } else {
+      const std::int32_t e = adjacency_.find(tip.a, tip.b), g = adjacency_.find(tip.b, tip.a);
+      const std::int32_t o = e >= 0 && e / 3 == last.face ? g : e;
+      if (o < 0) return false;  // a boundary edge
+      beyond = o / 3;
+    }
   } else {
     return false;
   }

@@ -50,8 +50,8 @@ class TipPlacement : public PathSplit {
 
   // Where the blade is in a face the tear made (the old tip's fan) too thin for a tip inside
   // it, the tip goes on an edge of the track instead: where Π leaves that face ahead of
-  // the hit (the face beyond split from its vertex opposite), or else on the edge crossing
-  // behind the hit. Each face it makes keeps twice min_angle, so that a later split keeps the
+  // the hit (the face beyond split from its vertex opposite; within a snap behind the hit, or
+  // on the vertex where Π leaves through one), or else on the edge crossing behind the hit. Each face it makes keeps twice min_angle, so that a later split keeps the
   // floor; nothing moves off the track and nothing is flipped, so the area is the faces' own.
   // False (nothing kept) when neither fits.
   bool split_with_tip_past_fan();
