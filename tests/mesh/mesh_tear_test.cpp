@@ -386,3 +386,27 @@ TEST(Tear, SweepToleranceMustBeNonNegative) {
   o.sweep_tolerance = std::nan("");
   EXPECT_THROW(Tear(m, adj, o), std::invalid_argument);
 }
+
+TEST(Tear, ShortStepsGoPastTheOldTipsFan) {
+  // Steps of a fifth of an edge on a coarse sheet, straight and at slants: where the blade
+  // lands in the old tip's fan, too thin for a tip inside it, the tip goes past the fan on the
+  // track's edge instead of waiting, with the same invariants (no sliver, area kept, open).
+  int steps = 0, waits = 0;
+  for (const double slope : {0.0, 0.35, 1.0}) {
+    const SkinnedMesh in = make_sheet(8, 8);
+    SkinnedMesh m = in;
+    Adjacency adj(m);
+    Tear tear(m, adj);
+    const int samples = 40;
+    for (int i = 0; i < samples; ++i) {
+      const double x = -0.4 + 0.8 * i / (samples - 1);
+      tear.advance(vertical(i, x, 0.0371 + slope * x));
+      waits += tear.message().rfind("the blade is in a face too thin", 0) == 0;
+    }
+    steps += tear.steps();
+    expect_torn(m, in, tear, "slope " + std::to_string(slope));
+  }
+  // Waiting in every such fan instead: 105 steps and 12 waits.
+  EXPECT_EQ(steps, 109);
+  EXPECT_EQ(waits, 8);
+}
