@@ -270,12 +270,25 @@ mesh::DrillTool drill_through(const PlacedDrill& at, const Section& s) {
   return {s.centre + reach * through, s.centre - reach * through, at.radius * s.scale};
 }
 
+namespace {
+// A vertex of the rings that hold the section is on a piece the cut released (fallen away).
+bool section_released(const bullet::SkinnedSoftBody& body, const SkinSection& section) {
+  for (const auto* ring : {&section.near_ring, &section.far_ring})
+    for (const std::int32_t v : *ring)
+      if (body.piece_released(body.piece_of(v))) return true;
+  return false;
+}
+}  // namespace
+
 Json apply_drill(bullet::SkinnedSoftBody& body, const BindPose& bind, const PlacedDrill& at,
                  const DrillEdit& edit) {
   Vec3 tip, base;
   double radius = 0;
   std::string bone;
-  if (at.section.near_ring.empty()) {
+  // In the box, or on a limb whose section a released piece took part of: carried by the
+  // bone from the bind pose (on a limb, the dominant bone of the section's nearest vertex).
+  const bool by_bone = at.section.near_ring.empty() || section_released(body, at.section);
+  if (by_bone) {
     const BoneCarrier carrier(body, bind, at.bone, 0.5 * (at.tip + at.base));
     tip = carrier.point(at.tip), base = carrier.point(at.base);
     radius = at.radius * carrier.scale(), bone = carrier.bone_name();
@@ -300,6 +313,7 @@ Json apply_drill(bullet::SkinnedSoftBody& body, const BindPose& bind, const Plac
                 {"area_per_hole_vs_disc", r.holes > 0 ? r.removed_area / (r.holes * disc) : 0.0},
                 {"detached_vertices", body.detached_count()}};
   if (edit.on_limb) event["limb"] = at.limb, event["along"] = edit.along;
+  if (edit.on_limb) event["held_by"] = by_bone ? "bone" : "skin";
   if (!r.message.empty()) event["message"] = r.message;
   return event;
 }

@@ -262,6 +262,12 @@ TEST(SceneCharacter, SeparateObjectsThatTouchAreNotSeams) {
   EXPECT_EQ(seams["touching_positions"].get<int>(), 8);
   EXPECT_EQ(seams["open_positions"].get<int>(), 0);
   EXPECT_LE(seams["max_gap_rel"].get<double>(), 1e-6);
+  // Each box is a limb whose section's rings are its ends, so the cut (before the drill)
+  // releases one end, and the ring on it falls away: the drill is carried by the box's bone
+  // instead of the skin (it missed, aimed by the fallen ring, before).
+  const Json& drill = s["metrics"]["drill"];
+  EXPECT_EQ(drill["status"].get<std::string>(), "drilled");
+  EXPECT_EQ(drill["held_by"].get<std::string>(), "bone");
 }
 
 }  // namespace
