@@ -312,8 +312,9 @@ Json apply_drill(bullet::SkinnedSoftBody& body, const BindPose& bind, const Plac
                 // The area removed per hole against the disc πr² (1 on a flat wall).
                 {"area_per_hole_vs_disc", r.holes > 0 ? r.removed_area / (r.holes * disc) : 0.0},
                 {"detached_vertices", body.detached_count()}};
-  if (edit.on_limb) event["limb"] = at.limb, event["along"] = edit.along;
-  if (edit.on_limb) event["held_by"] = by_bone ? "bone" : "skin";
+  if (edit.on_limb)
+    event["limb"] = at.limb, event["along"] = edit.along,
+    event["held_by"] = by_bone ? "bone" : "skin";
   if (!r.message.empty()) event["message"] = r.message;
   return event;
 }
